@@ -1,0 +1,29 @@
+# Compiler warnings shared by every target, as errors.
+function(taiga_set_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
+                                           -Werror)
+endfunction()
+
+# taiga_add_module(NAME DEPENDS <public deps> PRIVATE_DEPENDS <private deps>)
+# Builds src/NAME/*.cpp into the library taiga_NAME with the alias taiga::NAME.
+function(taiga_add_module name)
+  cmake_parse_arguments(ARG "" "" "DEPENDS;PRIVATE_DEPENDS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${name}/*.cpp)
+  add_library(taiga_${name} ${sources})
+  add_library(taiga::${name} ALIAS taiga_${name})
+  target_include_directories(taiga_${name} PUBLIC ${PROJECT_SOURCE_DIR}/include)
+  target_link_libraries(taiga_${name} PUBLIC ${ARG_DEPENDS} PRIVATE ${ARG_PRIVATE_DEPENDS})
+  target_compile_features(taiga_${name} PUBLIC cxx_std_20)
+  taiga_set_warnings(taiga_${name})
+endfunction()
+
+# taiga_add_test(MODULE NAME [LABELS ...]) builds tests/MODULE/NAME.cpp against taiga::MODULE.
+function(taiga_add_test module name)
+  cmake_parse_arguments(ARG "" "" "LABELS;DEPENDS" ${ARGN})
+  add_executable(${name} ${name}.cpp)
+  target_link_libraries(${name} PRIVATE taiga::${module} ${ARG_DEPENDS} GTest::gtest_main
+                                        GTest::gmock)
+  taiga_set_warnings(${name})
+  gtest_discover_tests(${name} PROPERTIES LABELS "${module};${ARG_LABELS}"
+                       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} DISCOVERY_TIMEOUT 60)
+endfunction()
