@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 namespace taiga::lie {
 namespace {
@@ -45,7 +46,12 @@ Matrix3 hat(const Vector3& v) {
 
 Vector3 vee(const Matrix3& skew) { return Vector3(skew(2, 1), skew(0, 2), skew(1, 0)); }
 
-SO3::SO3(const Eigen::Quaterniond& q) : q_(q.normalized()) { assert(q.norm() > 0.0); }
+SO3::SO3(const Eigen::Quaterniond& q) : q_(q) {
+  assert(q.norm() > 0.0);
+  // A quaternion that is already unit to rounding is kept as it is, so that rotations written
+  // to files with full precision read back bit for bit.
+  if (std::abs(q_.squaredNorm() - 1.0) > 4.0 * std::numeric_limits<double>::epsilon()) q_.normalize();
+}
 
 SO3 SO3::fromMatrix(const Matrix3& R) { return SO3(Eigen::Quaterniond(R)); }
 

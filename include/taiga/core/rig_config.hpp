@@ -1,0 +1,28 @@
+#pragma once
+// The sensor rig: where the lidar and the IMU sit on the body, and how their data must be read.
+// See docs/frames.md for the frames and a picture.
+
+#include "taiga/core/config.hpp"
+#include "taiga/lie/se3.hpp"
+
+namespace taiga {
+
+/// Unit of the IMU's acceleration output. Some drivers publish g instead of m/s^2.
+enum class AccelerationUnit { kAuto, kMetersPerSecond2, kStandardGravity };
+
+struct RigConfig final : ConfigSection {
+  /// Pose of the lidar in the body frame: p_body = T_body_lidar * p_lidar.
+  lie::SE3 T_body_lidar;
+  /// Pose of the IMU in the body frame: p_body = T_body_imu * p_imu. Identity when the body
+  /// frame is the IMU frame (the default).
+  lie::SE3 T_body_imu;
+  /// Added to every lidar time to express it on the IMU's clock, s.
+  double lidar_time_offset_s = 0.0;
+  /// Acceleration unit of the IMU; `auto` decides from the magnitude at rest.
+  AccelerationUnit imu_acceleration_unit = AccelerationUnit::kAuto;
+
+  void visit(ConfigVisitor& v) override;
+  void validate() const override;
+};
+
+}  // namespace taiga

@@ -1,0 +1,30 @@
+#include "taiga/core/rig_config.hpp"
+
+namespace taiga {
+
+void RigConfig::visit(ConfigVisitor& v) {
+  v.field("T_body_lidar", T_body_lidar,
+          "pose of the lidar frame in the body frame, p_body = T_body_lidar * p_lidar");
+  v.field("T_body_imu", T_body_imu,
+          "pose of the IMU frame in the body frame, p_body = T_body_imu * p_imu");
+  v.field("lidar_time_offset_s", lidar_time_offset_s,
+          "s, added to lidar times to put them on the IMU clock");
+  static constexpr std::array<std::pair<std::string_view, AccelerationUnit>, 3> kUnits{{
+      {"auto", AccelerationUnit::kAuto},
+      {"mps2", AccelerationUnit::kMetersPerSecond2},
+      {"g", AccelerationUnit::kStandardGravity},
+  }};
+  enumField(v, "imu_acceleration_unit", imu_acceleration_unit, kUnits,
+            "unit of the IMU acceleration: m/s^2 (mps2), standard gravity (g) or auto-detect");
+}
+
+void RigConfig::validate() const {
+  // A clock offset beyond a second is a unit mistake (ms or ns given as s), not a latency.
+  requireInRange("lidar_time_offset_s", lidar_time_offset_s, -1.0, 1.0, "s");
+  // A lever arm of tens of metres is a unit mistake (mm or cm given as m).
+  for (const auto& [key, T] : {std::pair{"T_body_lidar", &T_body_lidar}, {"T_body_imu", &T_body_imu}}) {
+    requireInRange(std::string(key) + ".translation_m", T->translation().norm(), 0.0, 10.0, "m (length)");
+  }
+}
+
+}  // namespace taiga
