@@ -164,7 +164,7 @@ TYPED_TEST(LieGroupTest, LeftAndRightPlusMinusAreConsistent) {
   for (const auto& tau : this->tangents()) {
     const TypeParam X = this->random();
     // tau (+) X = X (+) Adj(X)^-1 tau
-    const auto local = X.adjoint().inverse() * tau;
+    const typename TestFixture::Traits::Tangent local = X.adjoint().inverse() * tau;
     EXPECT_TRUE(X.plusLeft(tau).matrix().isApprox(X.plus(local).matrix(), 1e-9));
     EXPECT_LT((X.plusLeft(tau).minusLeft(X) - tau).norm(), 1e-9 * (1.0 + tau.norm()));
   }
