@@ -78,7 +78,8 @@ void BM_SE3TransformPoint(benchmark::State& state) {
 }
 
 void BM_EigenIsometryTransformPoint(benchmark::State& state) {
-  const Eigen::Isometry3d T = SE3(SO3::Exp(Eigen::Vector3d(0.1, 0.2, 0.3)), Eigen::Vector3d(1, 2, 3)).isometry();
+  const Eigen::Isometry3d T =
+      SE3(SO3::Exp(Eigen::Vector3d(0.1, 0.2, 0.3)), Eigen::Vector3d(1, 2, 3)).isometry();
   const auto points = randomVectors(30.0);
   std::size_t i = 0;
   for (auto _ : state) benchmark::DoNotOptimize(T * points[i++ & 1023]);

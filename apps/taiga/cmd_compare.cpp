@@ -17,7 +17,8 @@ Command addCompareCommand(CLI::App& tool) {
   CLI::App* parser = tool.add_subcommand(
       "compare", "Tabulate and plot the accuracy of several runs against one reference");
   parser->add_option("RUN_DIR", options->runs, "Output directories of `taiga run`")->required();
-  parser->add_option("--ref", options->reference, "Reference trajectory (TUM or KITTI)")->required();
+  parser->add_option("--ref", options->reference, "Reference trajectory (TUM or KITTI)")
+      ->required();
   return {parser, notImplemented("compare", "run comparison is issue 8"), options};
 }
 

@@ -16,7 +16,8 @@ Command addConfigCommand(CLI::App& tool) {
       "Check a configuration file and print the effective configuration (defaults overridden by "
       "FILE) as YAML with every key documented; without FILE, print the defaults");
   parser->add_option("FILE", *file, "YAML configuration file to check");
-  return {parser, [file] {
+  return {parser,
+          [file] {
             SystemConfig config;
             if (!file->empty()) io::readConfigYaml(*file, config);
             fmt::print("{}", io::writeConfigYaml(config));

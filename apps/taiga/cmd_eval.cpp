@@ -17,7 +17,8 @@ Command addEvalCommand(CLI::App& tool) {
   CLI::App* parser = tool.add_subcommand(
       "eval", "Compare an estimated trajectory with a reference (APE, RPE, drift, KITTI errors)");
   parser->add_option("--est", options->estimate, "Estimated trajectory (TUM or KITTI)")->required();
-  parser->add_option("--ref", options->reference, "Reference trajectory (TUM or KITTI)")->required();
+  parser->add_option("--ref", options->reference, "Reference trajectory (TUM or KITTI)")
+      ->required();
   parser->add_option("--align", options->align, "Alignment before comparing")
       ->check(CLI::IsMember({"se3", "sim3", "origin", "none"}))
       ->capture_default_str();

@@ -12,10 +12,10 @@ namespace taiga::app {
 /// Exit codes of the tool, documented in README.md.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFailure = 1,         ///< the work itself failed (e.g. a run diverged)
-  kExitBadInput = 2,        ///< bad command line, file or configuration; the message says which
-  kExitNotImplemented = 69, ///< the subcommand exists in the contract but is not built yet
-  kExitInternalError = 70,  ///< a bug in taiga; please report it with the message
+  kExitFailure = 1,          ///< the work itself failed (e.g. a run diverged)
+  kExitBadInput = 2,         ///< bad command line, file or configuration; the message says which
+  kExitNotImplemented = 69,  ///< the subcommand exists in the contract but is not built yet
+  kExitInternalError = 70,   ///< a bug in taiga; please report it with the message
 };
 
 struct Command {

@@ -31,9 +31,9 @@ int runTool(int argc, char** argv) {
   tool.add_flag("-q,--quiet", quiet, "Print only warnings and errors");
 
   const std::vector<Command> commands{
-      addSimulateCommand(tool), addInfoCommand(tool),    addExportCommand(tool),
-      addRegisterCommand(tool), addRunCommand(tool),     addEvalCommand(tool),
-      addCompareCommand(tool),  addGeorefCommand(tool),  addConfigCommand(tool)};
+      addSimulateCommand(tool), addInfoCommand(tool),   addExportCommand(tool),
+      addRegisterCommand(tool), addRunCommand(tool),    addEvalCommand(tool),
+      addCompareCommand(tool),  addGeorefCommand(tool), addConfigCommand(tool)};
 
   try {
     tool.parse(argc, argv);
@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "taiga: error: {}\n", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "taiga: internal error: {}\nPlease report this with the command you ran.\n", e.what());
+    fmt::print(stderr, "taiga: internal error: {}\nPlease report this with the command you ran.\n",
+               e.what());
     return kExitInternalError;
   }
 }

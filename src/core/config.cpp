@@ -40,7 +40,8 @@ void validateAll(ConfigSection& root) {
   root.visit(visitor);
 }
 
-void requireInRange(std::string_view key, double value, double min, double max, std::string_view unit) {
+void requireInRange(std::string_view key, double value, double min, double max,
+                    std::string_view unit) {
   if (!(value >= min && value <= max)) {  // also rejects NaN
     throw ConfigError(std::string(key), fmt::format("expected a value in [{}, {}]{}{}, got {}", min,
                                                     max, unit.empty() ? "" : " ", unit, value));

@@ -21,7 +21,8 @@ std::string formatProgressLine(const std::string& label, std::size_t done, std::
   const double rate = elapsed_s > 0.0 ? static_cast<double>(done) / elapsed_s : 0.0;
   const double remaining_s =
       rate > 0.0 && total >= done ? static_cast<double>(total - done) / rate : -1.0;
-  const double percent = total > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 0.0;
+  const double percent =
+      total > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 0.0;
   return fmt::format("{}  {}/{} {}  {:3.0f}%  {:.1f} {}/s  elapsed {}  remaining {}", label, done,
                      total, unit, percent, rate, unit, formatDuration(elapsed_s),
                      formatDuration(remaining_s));
@@ -32,7 +33,11 @@ Progress::Progress(std::string label, std::size_t total, std::string unit, std::
 
 Progress::Progress(std::string label, std::size_t total, std::string unit, std::FILE* out,
                    bool enabled)
-    : label_(std::move(label)), total_(total), unit_(std::move(unit)), out_(out), enabled_(enabled) {}
+    : label_(std::move(label)),
+      total_(total),
+      unit_(std::move(unit)),
+      out_(out),
+      enabled_(enabled) {}
 
 Progress::~Progress() { finish(); }
 
@@ -55,7 +60,8 @@ void Progress::draw() {
   last_draw_ = Clock::now();
   const double elapsed_s = std::chrono::duration<double>(last_draw_ - start_).count();
   // \r returns to the line start, \033[K clears what a longer previous line left behind.
-  std::fprintf(out_, "\r%s\033[K", formatProgressLine(label_, done_, total_, unit_, elapsed_s).c_str());
+  std::fprintf(out_, "\r%s\033[K",
+               formatProgressLine(label_, done_, total_, unit_, elapsed_s).c_str());
   std::fflush(out_);
 }
 

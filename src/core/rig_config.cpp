@@ -22,8 +22,10 @@ void RigConfig::validate() const {
   // A clock offset beyond a second is a unit mistake (ms or ns given as s), not a latency.
   requireInRange("lidar_time_offset_s", lidar_time_offset_s, -1.0, 1.0, "s");
   // A lever arm of tens of metres is a unit mistake (mm or cm given as m).
-  for (const auto& [key, T] : {std::pair{"T_body_lidar", &T_body_lidar}, {"T_body_imu", &T_body_imu}}) {
-    requireInRange(std::string(key) + ".translation_m", T->translation().norm(), 0.0, 10.0, "m (length)");
+  for (const auto& [key, T] :
+       {std::pair{"T_body_lidar", &T_body_lidar}, {"T_body_imu", &T_body_imu}}) {
+    requireInRange(std::string(key) + ".translation_m", T->translation().norm(), 0.0, 10.0,
+                   "m (length)");
   }
 }
 

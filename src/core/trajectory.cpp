@@ -20,9 +20,9 @@ void Trajectory::append(double t_s, const lie::SE3& pose) {
     throw std::invalid_argument(fmt::format("pose {} has a non-finite time", poses_.size()));
   }
   if (!poses_.empty() && !(t_s > poses_.back().t_s)) {
-    throw std::invalid_argument(fmt::format(
-        "pose {} at t = {:.9f} s is not after the previous pose at t = {:.9f} s", poses_.size(),
-        t_s, poses_.back().t_s));
+    throw std::invalid_argument(
+        fmt::format("pose {} at t = {:.9f} s is not after the previous pose at t = {:.9f} s",
+                    poses_.size(), t_s, poses_.back().t_s));
   }
   poses_.push_back({t_s, pose});
 }
@@ -45,7 +45,8 @@ std::optional<lie::SE3> Trajectory::tryPoseAt(double t_s) const {
 lie::SE3 Trajectory::poseAt(double t_s) const {
   if (auto pose = tryPoseAt(t_s)) return *pose;
   if (poses_.empty()) {
-    throw OutOfRangeError(fmt::format("pose requested at t = {:.6f} s from an empty trajectory", t_s));
+    throw OutOfRangeError(
+        fmt::format("pose requested at t = {:.6f} s from an empty trajectory", t_s));
   }
   const double outside_s = t_s < startTime() ? startTime() - t_s : t_s - endTime();
   throw OutOfRangeError(fmt::format(

@@ -30,10 +30,14 @@ std::string location(const std::string& source, const YAML::Mark& mark) {
 
 std::string describe(const YAML::Node& node) {
   switch (node.Type()) {
-    case YAML::NodeType::Scalar: return fmt::format("'{}'", node.Scalar());
-    case YAML::NodeType::Sequence: return fmt::format("a list of {}", node.size());
-    case YAML::NodeType::Map: return "a mapping";
-    default: return "nothing";
+    case YAML::NodeType::Scalar:
+      return fmt::format("'{}'", node.Scalar());
+    case YAML::NodeType::Sequence:
+      return fmt::format("a list of {}", node.size());
+    case YAML::NodeType::Map:
+      return "a mapping";
+    default:
+      return "nothing";
   }
 }
 
@@ -106,7 +110,8 @@ class Mapping {
     return entry ? entry->key_node.Mark() : YAML::Mark::null_mark();
   }
 
-  [[noreturn]] void fail(const YAML::Mark& mark, std::string_view key, const std::string& problem) const {
+  [[noreturn]] void fail(const YAML::Mark& mark, std::string_view key,
+                         const std::string& problem) const {
     throw InputError(fmt::format("{}: {}{}: {}", location(source_, mark), prefix_, key, problem));
   }
   const std::string& prefix() const { return prefix_; }
@@ -126,10 +131,12 @@ class Mapping {
   std::vector<std::string> known_;
 };
 
-double parseNumber(const Mapping& m, std::string_view key, const YAML::Node& node, std::string_view doc) {
+double parseNumber(const Mapping& m, std::string_view key, const YAML::Node& node,
+                   std::string_view doc) {
   double value = 0.0;
   if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
-    m.fail(node.Mark(), key, fmt::format("expected a finite number ({}), got {}", doc, describe(node)));
+    m.fail(node.Mark(), key,
+           fmt::format("expected a finite number ({}), got {}", doc, describe(node)));
   }
   return value;
 }
@@ -137,8 +144,8 @@ double parseNumber(const Mapping& m, std::string_view key, const YAML::Node& nod
 std::vector<double> parseNumbers(const Mapping& m, std::string_view key, const YAML::Node& node,
                                  std::size_t count, std::string_view layout) {
   if (!node.IsSequence() || node.size() != count) {
-    m.fail(node.Mark(), key, fmt::format("expected a list of {} numbers {}, got {}", count, layout,
-                                         describe(node)));
+    m.fail(node.Mark(), key,
+           fmt::format("expected a list of {} numbers {}, got {}", count, layout, describe(node)));
   }
   std::vector<double> values;
   for (const YAML::Node& element : node) values.push_back(parseNumber(m, key, element, layout));
@@ -152,7 +159,8 @@ lie::SE3 parsePose(const Mapping& parent, std::string_view key, const YAML::Node
   if (!node.IsMap()) {
     parent.fail(node.Mark(), key,
                 fmt::format("expected a mapping with translation_m and quaternion_xyzw or rpy_deg, "
-                            "got {}", describe(node)));
+                            "got {}",
+                            describe(node)));
   }
   Mapping m(node, parent.prefix() + std::string(key) + ".", parent.source());
   Eigen::Vector3d translation = current.translation();
@@ -165,14 +173,16 @@ lie::SE3 parsePose(const Mapping& parent, std::string_view key, const YAML::Node
   const auto rpy = m.take("rpy_deg");
   m.rejectUnknownKeys();
   if (quaternion && rpy) {
-    m.fail(rpy->Mark(), "rpy_deg", "give the rotation either as quaternion_xyzw or as rpy_deg, not both");
+    m.fail(rpy->Mark(), "rpy_deg",
+           "give the rotation either as quaternion_xyzw or as rpy_deg, not both");
   }
   if (quaternion) {
     const auto v = parseNumbers(m, "quaternion_xyzw", *quaternion, 4, "[x, y, z, w]");
     const Eigen::Quaterniond q(v[3], v[0], v[1], v[2]);
     if (std::abs(q.norm() - 1.0) > kQuaternionNormTolerance) {
-      m.fail(quaternion->Mark(), "quaternion_xyzw",
-             fmt::format("expected a unit quaternion in x, y, z, w order, got norm {:.4f}", q.norm()));
+      m.fail(
+          quaternion->Mark(), "quaternion_xyzw",
+          fmt::format("expected a unit quaternion in x, y, z, w order, got norm {:.4f}", q.norm()));
     }
     rotation = lie::SO3(q);
   }
@@ -195,7 +205,8 @@ class YamlReader final : public ConfigVisitor {
       section.validate();
     } catch (const ConfigError& e) {
       const std::string first_key = e.key().substr(0, e.key().find('.'));
-      throw InputError(fmt::format("{}: {}{}: {}", location(mapping_.source(), mapping_.markOf(first_key)),
+      throw InputError(fmt::format("{}: {}{}: {}",
+                                   location(mapping_.source(), mapping_.markOf(first_key)),
                                    mapping_.prefix(), e.key(), e.problem()));
     }
   }
@@ -212,13 +223,16 @@ class YamlReader final : public ConfigVisitor {
   void field(std::string_view key, bool& value, std::string_view) override {
     auto node = mapping_.take(key);
     if (node && (!node->IsScalar() || !YAML::convert<bool>::decode(*node, value))) {
-      mapping_.fail(node->Mark(), key, fmt::format("expected true or false, got {}", describe(*node)));
+      mapping_.fail(node->Mark(), key,
+                    fmt::format("expected true or false, got {}", describe(*node)));
     }
   }
   void field(std::string_view key, std::string& value, std::string_view) override {
     auto node = mapping_.take(key);
     if (!node) return;
-    if (!node->IsScalar()) mapping_.fail(node->Mark(), key, fmt::format("expected a text value, got {}", describe(*node)));
+    if (!node->IsScalar())
+      mapping_.fail(node->Mark(), key,
+                    fmt::format("expected a text value, got {}", describe(*node)));
     value = node->Scalar();
   }
   void field(std::string_view key, Eigen::Vector3d& value, std::string_view doc) override {
@@ -237,8 +251,9 @@ class YamlReader final : public ConfigVisitor {
     const bool valid = node->IsScalar() &&
                        std::find(allowed.begin(), allowed.end(), node->Scalar()) != allowed.end();
     if (!valid) {
-      mapping_.fail(node->Mark(), key, fmt::format("expected one of {}, got {}",
-                                                   fmt::join(allowed, ", "), describe(*node)));
+      mapping_.fail(
+          node->Mark(), key,
+          fmt::format("expected one of {}, got {}", fmt::join(allowed, ", "), describe(*node)));
     }
     value = node->Scalar();
   }
@@ -246,7 +261,8 @@ class YamlReader final : public ConfigVisitor {
     auto node = mapping_.take(key);
     if (!node || node->IsNull()) return;
     if (!node->IsMap()) {
-      mapping_.fail(node->Mark(), key, fmt::format("expected a mapping of keys, got {}", describe(*node)));
+      mapping_.fail(node->Mark(), key,
+                    fmt::format("expected a mapping of keys, got {}", describe(*node)));
     }
     YamlReader(*node, mapping_.prefix() + std::string(key) + ".", mapping_.source()).read(value);
   }
@@ -313,7 +329,8 @@ class YamlWriter final : public ConfigVisitor {
 
 }  // namespace
 
-void readConfigYamlText(std::string_view text, std::string_view source_name, ConfigSection& config) {
+void readConfigYamlText(std::string_view text, std::string_view source_name,
+                        ConfigSection& config) {
   const std::string source(source_name);
   YAML::Node root;
   try {
@@ -338,8 +355,9 @@ void readConfigYamlText(std::string_view text, std::string_view source_name, Con
 
 void readConfigYaml(const std::filesystem::path& path, ConfigSection& config) {
   if (!std::filesystem::is_regular_file(path)) {
-    throw InputError(fmt::format("{}: {}", path.string(),
-                                 std::filesystem::exists(path) ? "is not a regular file" : "no such file"));
+    throw InputError(
+        fmt::format("{}: {}", path.string(),
+                    std::filesystem::exists(path) ? "is not a regular file" : "no such file"));
   }
   std::ifstream stream(path);
   std::stringstream text;

@@ -40,7 +40,8 @@ bool NumericTextReader::next(std::vector<double>& values) {
       double value = 0.0;
       const auto [ptr, ec] = std::from_chars(first, last, value);
       if (ec == std::errc::result_out_of_range) {
-        fail(fmt::format("value {} '{}' is out of the range of a double", values.size() + 1, token));
+        fail(
+            fmt::format("value {} '{}' is out of the range of a double", values.size() + 1, token));
       }
       if (ec != std::errc() || ptr != last) {
         if (token.find(',') != std::string::npos) {

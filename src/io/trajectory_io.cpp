@@ -26,11 +26,13 @@ constexpr double kQuaternionNormTolerance = 1e-2;
 constexpr double kRotationOrthonormalityTolerance = 1e-3;
 
 // Appends with the line number in the error, instead of the pose index Trajectory would name.
-void appendChecked(NumericTextReader& reader, Trajectory& trajectory, double t_s, const lie::SE3& pose) {
+void appendChecked(NumericTextReader& reader, Trajectory& trajectory, double t_s,
+                   const lie::SE3& pose) {
   if (!trajectory.empty() && !(t_s > trajectory.back().t_s)) {
-    reader.fail(fmt::format("time {} is not after the previous pose's time {}; poses must be in "
-                            "strictly increasing time order", formatExact(t_s),
-                            formatExact(trajectory.back().t_s)));
+    reader.fail(
+        fmt::format("time {} is not after the previous pose's time {}; poses must be in "
+                    "strictly increasing time order",
+                    formatExact(t_s), formatExact(trajectory.back().t_s)));
   }
   trajectory.append(t_s, pose);
 }
@@ -44,7 +46,9 @@ void requireValueCount(NumericTextReader& reader, const std::vector<double>& val
 
 std::FILE* openForWriting(const std::filesystem::path& path) {
   std::FILE* file = std::fopen(path.c_str(), "w");
-  if (!file) throw InputError(fmt::format("{}: cannot open for writing: {}", path.string(), std::strerror(errno)));
+  if (!file)
+    throw InputError(
+        fmt::format("{}: cannot open for writing: {}", path.string(), std::strerror(errno)));
   return file;
 }
 
@@ -65,12 +69,15 @@ Trajectory readTum(const std::filesystem::path& path) {
     requireValueCount(reader, v, kTumValues, "t x y z qx qy qz qw");
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > kQuaternionNormTolerance) {
-      reader.fail(fmt::format("quaternion (qx qy qz qw) = ({} {} {} {}) has norm {:.6f}; expected a "
-                              "unit quaternion with w last", v[4], v[5], v[6], v[7], q.norm()));
+      reader.fail(
+          fmt::format("quaternion (qx qy qz qw) = ({} {} {} {}) has norm {:.6f}; expected a "
+                      "unit quaternion with w last",
+                      v[4], v[5], v[6], v[7], q.norm()));
     }
     appendChecked(reader, trajectory, v[0], lie::SE3(q, Eigen::Vector3d(v[1], v[2], v[3])));
   }
-  if (trajectory.empty()) reader.failFile("contains no poses (expected lines of 't x y z qx qy qz qw')");
+  if (trajectory.empty())
+    reader.failFile("contains no poses (expected lines of 't x y z qx qy qz qw')");
   return trajectory;
 }
 
@@ -89,21 +96,26 @@ Trajectory readKitti(const std::filesystem::path& path,
     R << v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10];
     const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
     if (error > kRotationOrthonormalityTolerance || R.determinant() < 0.0) {
-      reader.fail(fmt::format("the 3x3 block is not a rotation matrix (|R^T R - I| = {:.2g}, det = "
-                              "{:.4f})", error, R.determinant()));
+      reader.fail(
+          fmt::format("the 3x3 block is not a rotation matrix (|R^T R - I| = {:.2g}, det = "
+                      "{:.4f})",
+                      error, R.determinant()));
     }
     double t_s = static_cast<double>(trajectory.size());
     if (times_reader) {
       if (!times_reader->next(t)) {
         times_reader->failFile(fmt::format("has fewer times than {} has poses", path.string()));
       }
-      if (t.size() != 1) times_reader->fail(fmt::format("expected 1 value (time), found {}", t.size()));
+      if (t.size() != 1)
+        times_reader->fail(fmt::format("expected 1 value (time), found {}", t.size()));
       t_s = t[0];
     }
-    appendChecked(reader, trajectory, t_s, lie::SE3(lie::SO3::fromMatrix(R), Eigen::Vector3d(v[3], v[7], v[11])));
+    appendChecked(reader, trajectory, t_s,
+                  lie::SE3(lie::SO3::fromMatrix(R), Eigen::Vector3d(v[3], v[7], v[11])));
   }
   if (times_reader && times_reader->next(t)) {
-    times_reader->fail(fmt::format("more times than {} has poses ({})", path.string(), trajectory.size()));
+    times_reader->fail(
+        fmt::format("more times than {} has poses ({})", path.string(), trajectory.size()));
   }
   if (trajectory.empty()) reader.failFile("contains no poses (expected lines of 12 values)");
   return trajectory;
@@ -141,8 +153,10 @@ TrajectoryFormat detectTrajectoryFormat(const std::filesystem::path& path) {
   if (!reader.next(v)) reader.failFile("contains no poses");
   if (v.size() == kTumValues) return TrajectoryFormat::kTum;
   if (v.size() == kKittiValues) return TrajectoryFormat::kKitti;
-  reader.fail(fmt::format("found {} values; expected 8 (TUM: t x y z qx qy qz qw) or 12 (KITTI: "
-                          "3x4 matrix, row-major)", v.size()));
+  reader.fail(
+      fmt::format("found {} values; expected 8 (TUM: t x y z qx qy qz qw) or 12 (KITTI: "
+                  "3x4 matrix, row-major)",
+                  v.size()));
 }
 
 Trajectory readTrajectory(const std::filesystem::path& path) {

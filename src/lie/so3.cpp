@@ -50,7 +50,8 @@ SO3::SO3(const Eigen::Quaterniond& q) : q_(q) {
   assert(q.norm() > 0.0);
   // A quaternion that is already unit to rounding is kept as it is, so that rotations written
   // to files with full precision read back bit for bit.
-  if (std::abs(q_.squaredNorm() - 1.0) > 4.0 * std::numeric_limits<double>::epsilon()) q_.normalize();
+  if (std::abs(q_.squaredNorm() - 1.0) > 4.0 * std::numeric_limits<double>::epsilon())
+    q_.normalize();
 }
 
 SO3 SO3::fromMatrix(const Matrix3& R) { return SO3(Eigen::Quaterniond(R)); }

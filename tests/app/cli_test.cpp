@@ -37,10 +37,12 @@ TEST(Cli, PrintsItsVersion) {
 }
 
 TEST(Cli, EverySubcommandHasHelp) {
-  for (const char* name : {"simulate", "info", "export", "register", "run", "eval", "compare", "georef", "config"}) {
+  for (const char* name :
+       {"simulate", "info", "export", "register", "run", "eval", "compare", "georef", "config"}) {
     const Result r = runTaiga(std::string(name) + " --help");
     EXPECT_EQ(r.exit_code, 0) << name;
-    EXPECT_THAT(r.output, HasSubstr(std::string("Usage: ") + TAIGA_EXECUTABLE + " " + name)) << name;
+    EXPECT_THAT(r.output, HasSubstr(std::string("Usage: ") + TAIGA_EXECUTABLE + " " + name))
+        << name;
   }
 }
 
@@ -67,10 +69,12 @@ TEST(Cli, ConfigPrintsDefaultsAndNamesBadKeys) {
   EXPECT_THAT(defaults.output, HasSubstr("T_body_lidar:"));
 
   taiga::test::TempDir dir;
-  const auto typo = dir.write("typo.yaml", "rig:\n  T_body_lidar:\n    rpy_deg: [0, 0, 180]\n  lidar_offset_s: 0.1\n");
+  const auto typo = dir.write(
+      "typo.yaml", "rig:\n  T_body_lidar:\n    rpy_deg: [0, 0, 180]\n  lidar_offset_s: 0.1\n");
   const Result r = runTaiga("config " + typo.string());
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_THAT(r.output, HasSubstr("taiga: error: " + typo.string() + ":4:3: rig.lidar_offset_s: unknown key"));
+  EXPECT_THAT(r.output, HasSubstr("taiga: error: " + typo.string() +
+                                  ":4:3: rig.lidar_offset_s: unknown key"));
 
   const auto good = dir.write("good.yaml", "rig:\n  T_body_lidar:\n    rpy_deg: [0, 0, 180]\n");
   const Result ok = runTaiga("config " + good.string());

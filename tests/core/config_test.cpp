@@ -10,8 +10,8 @@
 namespace taiga {
 namespace {
 
-using ::testing::HasSubstr;
 using test::messageOf;
+using ::testing::HasSubstr;
 
 struct Inner final : ConfigSection {
   double voxel_m = 0.4;

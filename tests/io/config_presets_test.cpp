@@ -26,7 +26,8 @@ TEST(ConfigPresets, Os0ExtrinsicsMatchTheSensorMetadata) {
   // The lidar origin is 36.18 mm above the sensor base, the IMU 7.645 mm; yaw 180 degrees.
   const lie::SE3& T_body_lidar = config.rig.T_body_lidar;
   EXPECT_NEAR(T_body_lidar.translation().z(), 0.036180 - 0.007645, 1e-9);
-  EXPECT_TRUE((T_body_lidar.rotation() * Eigen::Vector3d::UnitX()).isApprox(-Eigen::Vector3d::UnitX(), 1e-12));
+  EXPECT_TRUE((T_body_lidar.rotation() * Eigen::Vector3d::UnitX())
+                  .isApprox(-Eigen::Vector3d::UnitX(), 1e-12));
 }
 
 }  // namespace

@@ -12,8 +12,8 @@
 namespace taiga::io {
 namespace {
 
-using ::testing::HasSubstr;
 using test::messageOf;
+using ::testing::HasSubstr;
 
 // A section with every field type the mechanism supports.
 struct Everything final : ConfigSection {
@@ -88,14 +88,16 @@ TEST(ConfigYaml, ReadsRigExtrinsicsAsQuaternionOrRollPitchYaw) {
 
 TEST(ConfigYaml, WrittenConfigReadsBackIdentically) {
   Everything original = read("voxel_m: 0.123456789012345\nname: 'true'\n");
-  original.T_a_b = lie::SE3(lie::SO3::fromRollPitchYaw(0.1, 0.2, 0.3), Eigen::Vector3d(0.1, 0.2, 0.3));
+  original.T_a_b =
+      lie::SE3(lie::SO3::fromRollPitchYaw(0.1, 0.2, 0.3), Eigen::Vector3d(0.1, 0.2, 0.3));
   const std::string text = writeConfigYaml(original);
   EXPECT_THAT(text, HasSubstr("# m"));  // documentation comes along as comments
   const Everything copy = read(text);
   EXPECT_EQ(copy.voxel_m, original.voxel_m);
   EXPECT_EQ(copy.name, "true");
   EXPECT_EQ(copy.T_a_b.translation(), original.T_a_b.translation());
-  EXPECT_EQ(copy.T_a_b.rotation().quaternion().coeffs(), original.T_a_b.rotation().quaternion().coeffs());
+  EXPECT_EQ(copy.T_a_b.rotation().quaternion().coeffs(),
+            original.T_a_b.rotation().quaternion().coeffs());
 }
 
 TEST(ConfigYaml, EmptyFileMeansDefaults) {
@@ -119,41 +121,59 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         // typos, at any depth, with a suggestion
         BadConfig{"voxel_m: 0.5\nvoxle_m: 0.3\n",
-                  "test.yaml:2:1: voxle_m: unknown key; did you mean 'voxel_m'? valid keys here: voxel_m, threads"},
+                  "test.yaml:2:1: voxle_m: unknown key; did you mean 'voxel_m'? valid keys here: "
+                  "voxel_m, threads"},
         BadConfig{"rig:\n  lidar_time_ofset_s: 0.1\n",
-                  "test.yaml:2:3: rig.lidar_time_ofset_s: unknown key; did you mean 'lidar_time_offset_s'?"},
+                  "test.yaml:2:3: rig.lidar_time_ofset_s: unknown key; did you mean "
+                  "'lidar_time_offset_s'?"},
         BadConfig{"T_a_b:\n  translation: [1, 2, 3]\n",
                   "test.yaml:2:3: T_a_b.translation: unknown key; did you mean 'translation_m'?"},
-        BadConfig{"completely_different: 1\n", "completely_different: unknown key; valid keys here"},
+        BadConfig{"completely_different: 1\n",
+                  "completely_different: unknown key; valid keys here"},
         // wrong types
-        BadConfig{"voxel_m: fast\n", "test.yaml:1:10: voxel_m: expected a finite number (m), got 'fast'"},
+        BadConfig{"voxel_m: fast\n",
+                  "test.yaml:1:10: voxel_m: expected a finite number (m), got 'fast'"},
         BadConfig{"voxel_m: .nan\n", "voxel_m: expected a finite number (m), got '.nan'"},
         BadConfig{"voxel_m: [1, 2]\n", "voxel_m: expected a finite number (m), got a list of 2"},
         BadConfig{"threads: 2.5\n", "test.yaml:1:10: threads: expected an integer, got '2.5'"},
         BadConfig{"deskew: maybe\n", "deskew: expected true or false, got 'maybe'"},
         BadConfig{"name: [a, b]\n", "name: expected a text value, got a list of 2"},
-        BadConfig{"gravity_mps2: [0, 0]\n", "gravity_mps2: expected a list of 3 numbers [x, y, z] (m/s^2), got a list of 2"},
-        BadConfig{"method: icp\n", "test.yaml:1:9: method: expected one of ndt, d2d, gicp, got 'icp'"},
+        BadConfig{"gravity_mps2: [0, 0]\n",
+                  "gravity_mps2: expected a list of 3 numbers [x, y, z] (m/s^2), got a list of 2"},
+        BadConfig{"method: icp\n",
+                  "test.yaml:1:9: method: expected one of ndt, d2d, gicp, got 'icp'"},
         BadConfig{"rig: 3\n", "test.yaml:1:6: rig: expected a mapping of keys, got '3'"},
-        BadConfig{"rig:\n  imu_acceleration_unit: G\n", "rig.imu_acceleration_unit: expected one of auto, mps2, g, got 'G'"},
+        BadConfig{"rig:\n  imu_acceleration_unit: G\n",
+                  "rig.imu_acceleration_unit: expected one of auto, mps2, g, got 'G'"},
         // extrinsics
-        BadConfig{"T_a_b: [1, 2, 3]\n", "T_a_b: expected a mapping with translation_m and quaternion_xyzw or rpy_deg"},
+        BadConfig{"T_a_b: [1, 2, 3]\n",
+                  "T_a_b: expected a mapping with translation_m and quaternion_xyzw or rpy_deg"},
         BadConfig{"T_a_b:\n  quaternion_xyzw: [0, 0, 0, 2]\n",
-                  "test.yaml:2:20: T_a_b.quaternion_xyzw: expected a unit quaternion in x, y, z, w order, got norm 2.0000"},
-        BadConfig{"T_a_b:\n  quaternion_xyzw: [0, 0, 1]\n", "T_a_b.quaternion_xyzw: expected a list of 4 numbers [x, y, z, w]"},
-        BadConfig{"T_a_b:\n  quaternion_xyzw: [0, 0, 0, 1]\n  rpy_deg: [0, 0, 0]\n",
-                  "T_a_b.rpy_deg: give the rotation either as quaternion_xyzw or as rpy_deg, not both"},
-        BadConfig{"T_a_b:\n  translation_m: [0, 0, x]\n", "T_a_b.translation_m: expected a finite number ([x, y, z] in m), got 'x'"},
+                  "test.yaml:2:20: T_a_b.quaternion_xyzw: expected a unit quaternion in x, y, z, w "
+                  "order, got norm 2.0000"},
+        BadConfig{"T_a_b:\n  quaternion_xyzw: [0, 0, 1]\n",
+                  "T_a_b.quaternion_xyzw: expected a list of 4 numbers [x, y, z, w]"},
+        BadConfig{
+            "T_a_b:\n  quaternion_xyzw: [0, 0, 0, 1]\n  rpy_deg: [0, 0, 0]\n",
+            "T_a_b.rpy_deg: give the rotation either as quaternion_xyzw or as rpy_deg, not both"},
+        BadConfig{"T_a_b:\n  translation_m: [0, 0, x]\n",
+                  "T_a_b.translation_m: expected a finite number ([x, y, z] in m), got 'x'"},
         // out of range, located at the key
-        BadConfig{"voxel_m: -0.4\n", "test.yaml:1:1: voxel_m: expected a positive value, got -0.4 m"},
+        BadConfig{"voxel_m: -0.4\n",
+                  "test.yaml:1:1: voxel_m: expected a positive value, got -0.4 m"},
         BadConfig{"threads: 0\n", "test.yaml:1:1: threads: expected a value in [1, 64], got 0"},
-        BadConfig{"rig:\n  lidar_time_offset_s: 50\n", "test.yaml:2:3: rig.lidar_time_offset_s: expected a value in [-1, 1] s, got 50"},
+        BadConfig{"rig:\n  lidar_time_offset_s: 50\n",
+                  "test.yaml:2:3: rig.lidar_time_offset_s: expected a value in [-1, 1] s, got 50"},
         BadConfig{"rig:\n  T_body_lidar:\n    translation_m: [0, 0, 150]\n",
-                  "test.yaml:2:3: rig.T_body_lidar.translation_m: expected a value in [0, 10] m (length), got 150"},
+                  "test.yaml:2:3: rig.T_body_lidar.translation_m: expected a value in [0, 10] m "
+                  "(length), got 150"},
         // structure
-        BadConfig{"voxel_m: 0.5\nvoxel_m: 0.6\n", "test.yaml:2:1: voxel_m: appears twice (first on line 1)"},
+        BadConfig{"voxel_m: 0.5\nvoxel_m: 0.6\n",
+                  "test.yaml:2:1: voxel_m: appears twice (first on line 1)"},
         BadConfig{"voxel_m: [0.5\n", "test.yaml:2:1: YAML syntax error"},
-        BadConfig{"- 1\n- 2\n", "test.yaml:1:1: expected a mapping of sections at the top level, got a list of 2"}));
+        BadConfig{
+            "- 1\n- 2\n",
+            "test.yaml:1:1: expected a mapping of sections at the top level, got a list of 2"}));
 
 TEST(ConfigYaml, ReadsFilesAndNamesMissingOnes) {
   test::TempDir dir;
@@ -164,8 +184,9 @@ TEST(ConfigYaml, ReadsFilesAndNamesMissingOnes) {
               HasSubstr("none.yaml: no such file"));
   EXPECT_THAT(messageOf<InputError>([&] { readConfigYaml(dir.path(), config); }),
               HasSubstr("is not a regular file"));
-  EXPECT_THAT(messageOf<InputError>([&] { readConfigYaml(dir.write("bad.yaml", "threads: x\n"), config); }),
-              HasSubstr("bad.yaml:1:10: threads: expected an integer"));
+  EXPECT_THAT(
+      messageOf<InputError>([&] { readConfigYaml(dir.write("bad.yaml", "threads: x\n"), config); }),
+      HasSubstr("bad.yaml:1:10: threads: expected an integer"));
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 #include "taiga/io/trajectory_io.hpp"
 
-#include <gmock/gmock.h>
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "../support/lie_test_support.hpp"
@@ -11,14 +11,15 @@
 namespace taiga::io {
 namespace {
 
-using ::testing::HasSubstr;
 using test::messageOf;
+using ::testing::HasSubstr;
 
 Trajectory randomTrajectory(int count) {
   test::RandomLie rng(7);
   Trajectory trajectory;
   // Times like a real recording's: large epoch seconds with sub-microsecond digits.
-  for (int i = 0; i < count; ++i) trajectory.append(1700000000.123456789 + 0.1 * i + 1e-7 * i, rng.se3());
+  for (int i = 0; i < count; ++i)
+    trajectory.append(1700000000.123456789 + 0.1 * i + 1e-7 * i, rng.se3());
   return trajectory;
 }
 
@@ -27,7 +28,8 @@ void expectBitIdentical(const Trajectory& a, const Trajectory& b) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].t_s, b[i].t_s);
     EXPECT_EQ(a[i].pose.translation(), b[i].pose.translation());
-    EXPECT_EQ(a[i].pose.rotation().quaternion().coeffs(), b[i].pose.rotation().quaternion().coeffs());
+    EXPECT_EQ(a[i].pose.rotation().quaternion().coeffs(),
+              b[i].pose.rotation().quaternion().coeffs());
   }
 }
 
@@ -58,7 +60,8 @@ TEST(TrajectoryIo, KittiRoundTripKeepsPosesAndTakesTimesFromAFile) {
 
 TEST(TrajectoryIo, AcceptsCommentsBlankLinesTabsAndCrlf) {
   test::TempDir dir;
-  const auto path = dir.write("t.tum", "# header\n\n1.0 0 0 0 0 0 0 1\r\n  2.0\t1 +2 3 0 0 0 1\n# end\n");
+  const auto path =
+      dir.write("t.tum", "# header\n\n1.0 0 0 0 0 0 0 1\r\n  2.0\t1 +2 3 0 0 0 1\n# end\n");
   const Trajectory trajectory = readTrajectory(path);
   ASSERT_EQ(trajectory.size(), 2u);
   EXPECT_EQ(trajectory[1].pose.translation(), Eigen::Vector3d(1, 2, 3));
@@ -82,7 +85,8 @@ TEST_P(TumRejects, WithFileLineAndReason) {
 INSTANTIATE_TEST_SUITE_P(
     MalformedLines, TumRejects,
     ::testing::Values(
-        BadTum{"1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n", ":2: expected 8 values (t x y z qx qy qz qw), found 7"},
+        BadTum{"1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n",
+               ":2: expected 8 values (t x y z qx qy qz qw), found 7"},
         BadTum{"1 0 0 0 0 0 0 1 5\n", ":1: expected 8 values (t x y z qx qy qz qw), found 9"},
         BadTum{"# c\n1 0 zero 0 0 0 0 1\n", ":2: value 3 'zero' is not a number"},
         BadTum{"1 0 0 nan 0 0 0 1\n", ":1: value 4 'nan' is not a finite number"},
@@ -90,11 +94,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadTum{"1,0,0,0,0,0,0,1\n", ":1: value 1 '1,0,0,0,0,0,0,1' contains a comma"},
         BadTum{"1 0 0 0 0 0 0 0\n", ":1: quaternion (qx qy qz qw) = (0 0 0 0) has norm 0.000000"},
         BadTum{"1 0 0 0 0 0 0.5 0.5\n", "expected a unit quaternion with w last"},
-        BadTum{"1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n", ":2: time 1 is not after the previous pose's time 1"},
+        BadTum{"1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n",
+               ":2: time 1 is not after the previous pose's time 1"},
         BadTum{"2 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n", ":2: time 1 is not after"},
         BadTum{"1 0 0 0 0 0 0 1e999\n", ":1: value 8 '1e999' is out of the range of a double"},
-        BadTum{"", ": contains no poses"},
-        BadTum{"# only a comment\n", ": contains no poses"}));
+        BadTum{"", ": contains no poses"}, BadTum{"# only a comment\n", ": contains no poses"}));
 
 TEST(TrajectoryIo, RejectsMissingFilesAndDirectories) {
   test::TempDir dir;

@@ -39,7 +39,8 @@ class LieGroupTest : public ::testing::Test {
   // Tangents at every edge-case angle plus random ones, all with angle below pi.
   std::vector<typename Traits::Tangent> tangents() {
     std::vector<typename Traits::Tangent> out;
-    for (double angle : test::edgeCaseAngles()) out.push_back(Traits::tangentWithAngle(rng_, angle));
+    for (double angle : test::edgeCaseAngles())
+      out.push_back(Traits::tangentWithAngle(rng_, angle));
     for (int i = 0; i < 30; ++i) out.push_back(Traits::tangentWithAngle(rng_, 3.1 * i / 30.0));
     return out;
   }
@@ -75,8 +76,10 @@ TYPED_TEST(LieGroupTest, JacobianInversesAndLeftRightRelation) {
   using Jacobian = typename TestFixture::Traits::Jacobian;
   for (const auto& tau : this->tangents()) {
     const Jacobian I = Jacobian::Identity();
-    EXPECT_TRUE((TypeParam::rightJacobian(tau) * TypeParam::rightJacobianInverse(tau)).isApprox(I, 1e-9));
-    EXPECT_TRUE((TypeParam::leftJacobian(tau) * TypeParam::leftJacobianInverse(tau)).isApprox(I, 1e-9));
+    EXPECT_TRUE(
+        (TypeParam::rightJacobian(tau) * TypeParam::rightJacobianInverse(tau)).isApprox(I, 1e-9));
+    EXPECT_TRUE(
+        (TypeParam::leftJacobian(tau) * TypeParam::leftJacobianInverse(tau)).isApprox(I, 1e-9));
     // Jl(tau) = Adj(Exp(tau)) Jr(tau)
     EXPECT_TRUE(TypeParam::leftJacobian(tau).isApprox(
         TypeParam::Exp(tau).adjoint() * TypeParam::rightJacobian(tau), 1e-9));
@@ -93,7 +96,8 @@ TYPED_TEST(LieGroupTest, RightAndLeftJacobiansMatchNumerical) {
     for (int i = 0; i < Tangent::RowsAtCompileTime; ++i) {
       const Tangent d = Tangent::Unit(i) * 1e-6;
       Jl.col(i) = (TypeParam::Exp(tau + d).minusLeft(TypeParam::Exp(tau)) -
-                   TypeParam::Exp(tau - d).minusLeft(TypeParam::Exp(tau))) / 2e-6;
+                   TypeParam::Exp(tau - d).minusLeft(TypeParam::Exp(tau))) /
+                  2e-6;
     }
     EXPECT_TRUE(TypeParam::leftJacobian(tau).isApprox(Jl, kJacobianTol)) << tau.transpose();
   }
@@ -106,8 +110,8 @@ TYPED_TEST(LieGroupTest, ExpAndLogJacobiansMatchNumerical) {
     Jacobian J_exp, J_log;
     const TypeParam X = TypeParam::Exp(tau, &J_exp);
     X.Log(&J_log);
-    EXPECT_TRUE(J_exp.isApprox(numericalJacobian([](const Tangent& t) { return TypeParam::Exp(t); }, tau),
-                               kJacobianTol));
+    EXPECT_TRUE(J_exp.isApprox(
+        numericalJacobian([](const Tangent& t) { return TypeParam::Exp(t); }, tau), kJacobianTol));
     EXPECT_TRUE(J_log.isApprox(numericalJacobian([](const TypeParam& Y) { return Y.Log(); }, X),
                                kJacobianTol))
         << tau.transpose();
@@ -124,8 +128,10 @@ TYPED_TEST(LieGroupTest, InverseAndComposeJacobiansMatchNumerical) {
     EXPECT_TRUE(J_inv.isApprox(numericalJacobian([](const TypeParam& A) { return A.inverse(); }, X),
                                kJacobianTol));
     X.compose(Y, &J_X, &J_Y);
-    EXPECT_TRUE(J_X.isApprox(numericalJacobian([&](const TypeParam& A) { return A * Y; }, X), kJacobianTol));
-    EXPECT_TRUE(J_Y.isApprox(numericalJacobian([&](const TypeParam& B) { return X * B; }, Y), kJacobianTol));
+    EXPECT_TRUE(J_X.isApprox(numericalJacobian([&](const TypeParam& A) { return A * Y; }, X),
+                             kJacobianTol));
+    EXPECT_TRUE(J_Y.isApprox(numericalJacobian([&](const TypeParam& B) { return X * B; }, Y),
+                             kJacobianTol));
   }
 }
 
@@ -136,15 +142,19 @@ TYPED_TEST(LieGroupTest, PlusMinusJacobiansMatchNumerical) {
     const TypeParam X = this->random();
     Jacobian J_X, J_tau;
     const TypeParam Y = X.plus(tau, &J_X, &J_tau);
-    EXPECT_TRUE(J_X.isApprox(numericalJacobian([&](const TypeParam& A) { return A.plus(tau); }, X), kJacobianTol));
-    EXPECT_TRUE(J_tau.isApprox(numericalJacobian([&](const Tangent& t) { return X.plus(t); }, tau), kJacobianTol));
+    EXPECT_TRUE(J_X.isApprox(numericalJacobian([&](const TypeParam& A) { return A.plus(tau); }, X),
+                             kJacobianTol));
+    EXPECT_TRUE(J_tau.isApprox(numericalJacobian([&](const Tangent& t) { return X.plus(t); }, tau),
+                               kJacobianTol));
 
     Jacobian J_d_Y, J_d_X;
     const Tangent d = Y.minus(X, &J_d_Y, &J_d_X);
     EXPECT_LT((d - tau).norm(), 1e-9 * (1.0 + tau.norm()));
-    EXPECT_TRUE(J_d_Y.isApprox(numericalJacobian([&](const TypeParam& B) { return B.minus(X); }, Y), kJacobianTol))
+    EXPECT_TRUE(J_d_Y.isApprox(numericalJacobian([&](const TypeParam& B) { return B.minus(X); }, Y),
+                               kJacobianTol))
         << tau.transpose();
-    EXPECT_TRUE(J_d_X.isApprox(numericalJacobian([&](const TypeParam& A) { return Y.minus(A); }, X), kJacobianTol))
+    EXPECT_TRUE(J_d_X.isApprox(numericalJacobian([&](const TypeParam& A) { return Y.minus(A); }, X),
+                               kJacobianTol))
         << tau.transpose();
   }
 }

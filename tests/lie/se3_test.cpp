@@ -54,8 +54,10 @@ TEST(SE3, ActionJacobiansMatchNumerical) {
     Matrix36 J_T;
     Matrix3 J_p;
     T.act(p, &J_T, &J_p);
-    EXPECT_TRUE(J_T.isApprox(test::numericalJacobian([&](const SE3& X) { return X * p; }, T), 1e-6));
-    EXPECT_TRUE(J_p.isApprox(test::numericalJacobian([&](const Vector3& q) { return T * q; }, p), 1e-6));
+    EXPECT_TRUE(
+        J_T.isApprox(test::numericalJacobian([&](const SE3& X) { return X * p; }, T), 1e-6));
+    EXPECT_TRUE(
+        J_p.isApprox(test::numericalJacobian([&](const Vector3& q) { return T * q; }, p), 1e-6));
   }
 }
 

@@ -67,17 +67,19 @@ TEST(SO3, ActionAndItsJacobians) {
     const Vector3 p = rng.translation();
     Matrix3 J_R, J_p;
     EXPECT_TRUE(R.act(p, &J_R, &J_p).isApprox(R.matrix() * p));
-    EXPECT_TRUE(J_R.isApprox(test::numericalJacobian([&](const SO3& X) { return X * p; }, R), 1e-6));
-    EXPECT_TRUE(J_p.isApprox(test::numericalJacobian([&](const Vector3& q) { return R * q; }, p), 1e-6));
+    EXPECT_TRUE(
+        J_R.isApprox(test::numericalJacobian([&](const SO3& X) { return X * p; }, R), 1e-6));
+    EXPECT_TRUE(
+        J_p.isApprox(test::numericalJacobian([&](const Vector3& q) { return R * q; }, p), 1e-6));
   }
 }
 
 TEST(SO3, RollPitchYawIsExtrinsicXYZ) {
   const double roll = 0.1, pitch = -0.4, yaw = 2.0;
-  const Matrix3 expected = (Eigen::AngleAxisd(yaw, Vector3::UnitZ()) *
-                            Eigen::AngleAxisd(pitch, Vector3::UnitY()) *
-                            Eigen::AngleAxisd(roll, Vector3::UnitX()))
-                               .toRotationMatrix();
+  const Matrix3 expected =
+      (Eigen::AngleAxisd(yaw, Vector3::UnitZ()) * Eigen::AngleAxisd(pitch, Vector3::UnitY()) *
+       Eigen::AngleAxisd(roll, Vector3::UnitX()))
+          .toRotationMatrix();
   EXPECT_TRUE(SO3::fromRollPitchYaw(roll, pitch, yaw).matrix().isApprox(expected, 1e-14));
   // Yaw of 90 degrees turns the x axis into the y axis.
   EXPECT_TRUE((SO3::fromRollPitchYaw(0, 0, kPi / 2) * Vector3::UnitX()).isApprox(Vector3::UnitY()));
@@ -87,7 +89,8 @@ TEST(SO3, FromMatrixProjectsANoisyMatrix) {
   const SO3 R = SO3::fromAxisAngle(Vector3(1, 2, 3), 0.7);
   const Matrix3 noisy = R.matrix() + 1e-7 * Matrix3::Ones();
   const SO3 projected = SO3::fromMatrix(noisy);
-  EXPECT_TRUE((projected.matrix() * projected.matrix().transpose()).isApprox(Matrix3::Identity(), 1e-14));
+  EXPECT_TRUE(
+      (projected.matrix() * projected.matrix().transpose()).isApprox(Matrix3::Identity(), 1e-14));
   EXPECT_LT(projected.minus(R).norm(), 1e-6);
 }
 

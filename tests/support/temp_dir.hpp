@@ -2,11 +2,11 @@
 // A fresh directory per test, removed afterwards, with a helper to write small text files.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 namespace taiga::test {
 

@@ -68,7 +68,8 @@ void validateAll(ConfigSection& root);
 /// Presents an enum field as a choice among names. `names` pairs each value with its name.
 template <class Enum, std::size_t N>
 void enumField(ConfigVisitor& visitor, std::string_view key, Enum& value,
-               const std::array<std::pair<std::string_view, Enum>, N>& names, std::string_view doc) {
+               const std::array<std::pair<std::string_view, Enum>, N>& names,
+               std::string_view doc) {
   std::array<std::string_view, N> allowed;
   std::string current;
   for (std::size_t i = 0; i < N; ++i) {
@@ -82,7 +83,8 @@ void enumField(ConfigVisitor& visitor, std::string_view key, Enum& value,
 }
 
 /// Checks used by validate(): each throws ConfigError(key, "expected ..., got ...").
-void requireInRange(std::string_view key, double value, double min, double max, std::string_view unit);
+void requireInRange(std::string_view key, double value, double min, double max,
+                    std::string_view unit);
 void requirePositive(std::string_view key, double value, std::string_view unit);
 void requireNonNegative(std::string_view key, double value, std::string_view unit);
 

@@ -24,9 +24,9 @@ struct ImuOrientation {
 
 struct ImuSample {
   double t_s = 0.0;
-  Eigen::Vector3d acceleration_imu_mps2 = Eigen::Vector3d::Zero();  ///< specific force, m/s^2
+  Eigen::Vector3d acceleration_imu_mps2 = Eigen::Vector3d::Zero();       ///< specific force, m/s^2
   Eigen::Vector3d angular_velocity_imu_radps = Eigen::Vector3d::Zero();  ///< rad/s
-  std::optional<ImuOrientation> orientation;  ///< absent for 6-axis IMUs
+  std::optional<ImuOrientation> orientation;                             ///< absent for 6-axis IMUs
 };
 
 /// Fix quality, with the values of sensor_msgs/NavSatStatus.
@@ -37,9 +37,9 @@ enum class GnssCovarianceType { kUnknown = 0, kApproximated = 1, kDiagonalKnown 
 
 struct GnssFix {
   double t_s = 0.0;
-  double latitude_deg = 0.0;          ///< geodetic latitude, positive north
-  double longitude_deg = 0.0;         ///< geodetic longitude, positive east
-  double height_ellipsoid_m = 0.0;    ///< height above the ellipsoid (not above sea level)
+  double latitude_deg = 0.0;        ///< geodetic latitude, positive north
+  double longitude_deg = 0.0;       ///< geodetic longitude, positive east
+  double height_ellipsoid_m = 0.0;  ///< height above the ellipsoid (not above sea level)
   /// Position covariance in the local east-north-up frame at the fix, m^2.
   Eigen::Matrix3d covariance_enu_m2 = Eigen::Matrix3d::Identity();
   GnssCovarianceType covariance_type = GnssCovarianceType::kUnknown;
