@@ -5,10 +5,10 @@ function(taiga_set_warnings target)
 endfunction()
 
 # taiga_add_module(NAME DEPENDS <public deps> PRIVATE_DEPENDS <private deps>)
-# Builds src/NAME/*.cpp into the library taiga_NAME with the alias taiga::NAME.
+# Builds src/NAME/**/*.cpp into the library taiga_NAME with the alias taiga::NAME.
 function(taiga_add_module name)
   cmake_parse_arguments(ARG "" "" "DEPENDS;PRIVATE_DEPENDS" ${ARGN})
-  file(GLOB sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${name}/*.cpp)
+  file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${name}/*.cpp)
   add_library(taiga_${name} ${sources})
   add_library(taiga::${name} ALIAS taiga_${name})
   target_include_directories(taiga_${name} PUBLIC ${PROJECT_SOURCE_DIR}/include)

@@ -1,0 +1,46 @@
+#pragma once
+// Recordings: one time-ordered stream of scans, IMU samples and GNSS fixes, whatever the source
+// (ROS1 bag, Ouster pcap + metadata JSON, or a folder of files).
+//
+// Each source format provides one StreamSource per sensor stream; MergedRecording merges them by
+// event time. A scan's event time is the time of its last point, because a scan can be processed
+// only once it is complete (and the IMU up to its end has arrived).
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "taiga/core/point_cloud.hpp"
+#include "taiga/core/sensor_samples.hpp"
+
+namespace taiga::io {
+
+/// One lidar sweep. Per-point times are absolute, on the IMU clock once the recording's lidar
+/// clock offset is applied.
+struct Scan {
+  std::uint64_t index = 0;   ///< 0, 1, 2, ... in the order the stream delivers scans
+  double t_start_s = 0.0;    ///< time of the scan's first firing (column), s
+  double t_end_s = 0.0;      ///< time of the scan's last point, s: the scan's event time
+  PointCloud cloud_in_lidar; ///< valid returns only (no NaN, no zero-range points)
+};
+
+using RecordingEvent = std::variant<Scan, ImuSample, GnssFix>;
+
+/// The time at which an event is complete: a scan's end, a sample's or a fix's time.
+double eventTime(const RecordingEvent& event);
+
+/// One sensor stream of a recording, delivering events of one kind in non-decreasing time order.
+class StreamSource {
+ public:
+  virtual ~StreamSource() = default;
+  /// A short name for messages, e.g. "/os_cloud_node/points" or "capture.pcap (lidar)".
+  virtual std::string name() const = 0;
+  /// The next event, or nothing at the end of the stream. Throws InputError on corrupt input.
+  virtual std::optional<RecordingEvent> next() = 0;
+};
+
+}  // namespace taiga::io
