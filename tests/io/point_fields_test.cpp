@@ -1,0 +1,206 @@
+#include "taiga/io/point_fields.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include "../support/temp_dir.hpp"
+#include "taiga/core/errors.hpp"
+
+namespace taiga::io {
+namespace {
+
+using ::testing::HasSubstr;
+using test::messageOf;
+
+// Packs records field by field, the way a driver fills a PointCloud2.
+class Packer {
+ public:
+  explicit Packer(std::vector<PointField> fields, bool big_endian = false) : big_endian_(big_endian) {
+    points_.fields = std::move(fields);
+    for (const PointField& f : points_.fields) {
+      points_.point_step = std::max<std::uint32_t>(points_.point_step, f.offset + fieldTypeSize(f.type));
+    }
+  }
+  // Appends one point: values in field order.
+  void add(std::initializer_list<double> values) {
+    const std::size_t base = bytes_.size();
+    bytes_.resize(base + points_.point_step, 0);
+    auto v = values.begin();
+    for (const PointField& f : points_.fields) write(bytes_.data() + base + f.offset, f.type, *v++);
+  }
+  PackedPoints finish(std::uint32_t height = 1) {
+    points_.height = height;
+    points_.width = static_cast<std::uint32_t>(bytes_.size() / points_.point_step / height);
+    points_.row_step = points_.width * points_.point_step;
+    points_.is_bigendian = big_endian_;
+    points_.data = bytes_;
+    return points_;
+  }
+
+ private:
+  void write(std::uint8_t* p, FieldType type, double value) {
+    auto put = [&]<class T>(T typed) {
+      std::memcpy(p, &typed, sizeof(T));
+      if (big_endian_) std::reverse(p, p + sizeof(T));
+    };
+    switch (type) {
+      case FieldType::kInt8: put(static_cast<std::int8_t>(value)); break;
+      case FieldType::kUint8: put(static_cast<std::uint8_t>(value)); break;
+      case FieldType::kInt16: put(static_cast<std::int16_t>(value)); break;
+      case FieldType::kUint16: put(static_cast<std::uint16_t>(value)); break;
+      case FieldType::kInt32: put(static_cast<std::int32_t>(value)); break;
+      case FieldType::kUint32: put(static_cast<std::uint32_t>(value)); break;
+      case FieldType::kFloat32: put(static_cast<float>(value)); break;
+      case FieldType::kFloat64: put(value); break;
+    }
+  }
+  PackedPoints points_;
+  std::vector<std::uint8_t> bytes_;
+  bool big_endian_;
+};
+
+using F = FieldType;
+
+TEST(PointFields, OusterLayoutOrganizedWithNanosecondOffsets) {
+  // ouster-ros: x y z intensity (float32), t (uint32 ns), reflectivity, ring (uint16); 2 rows.
+  Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}, {"intensity", 16, F::kFloat32},
+                 {"t", 20, F::kUint32}, {"reflectivity", 24, F::kUint16}, {"ring", 26, F::kUint16}});
+  for (int row = 0; row < 2; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      const bool missing = row == 1 && col == 1;  // no return: all zero
+      packer.add({missing ? 0.0 : 1.0 + col, missing ? 0.0 : 2.0, missing ? 0.0 : 0.5, 900.0, col * 1e6, 40.0 + col, double(row)});
+    }
+  }
+  const DecodedPoints d = decodePackedPoints(packer.finish(2), 1000.0);
+  ASSERT_EQ(d.cloud.size(), 5u);
+  EXPECT_EQ(d.dropped_invalid, 1u);
+  EXPECT_EQ(d.time_source, PointTimeSource::kRelativeField);
+  EXPECT_EQ(d.time_description, "field 't' (uint32, ns after the stamp)");
+  EXPECT_DOUBLE_EQ(d.cloud.times_s[2], 1000.002);
+  EXPECT_EQ(d.cloud.intensities[1], 41.0f);  // reflectivity is preferred over intensity
+  EXPECT_EQ(d.cloud.rings[4], 1);
+  EXPECT_EQ(d.cloud.columns[4], 2);
+  EXPECT_EQ(d.cloud.positions[4], Eigen::Vector3d(3.0, 2.0, 0.5));
+  EXPECT_TRUE(d.cloud.isConsistent());
+}
+
+TEST(PointFields, VelodyneRelativeSecondsAndBigEndian) {
+  for (bool big_endian : {false, true}) {
+    Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}, {"intensity", 12, F::kFloat32},
+                   {"ring", 16, F::kUint16}, {"time", 18, F::kFloat32}},
+                  big_endian);
+    packer.add({1, 0, 0, 7, 3, -0.05});
+    packer.add({0, 1, 0, 8, 4, 0.025});
+    const DecodedPoints d = decodePackedPoints(packer.finish(), 50.0);
+    ASSERT_EQ(d.cloud.size(), 2u) << big_endian;
+    EXPECT_NEAR(d.cloud.times_s[0], 49.95, 1e-6);
+    EXPECT_NEAR(d.cloud.times_s[1], 50.025, 1e-6);
+    EXPECT_EQ(d.cloud.rings[1], 4);
+    EXPECT_EQ(d.cloud.intensities[0], 7.0f);
+    EXPECT_FALSE(d.cloud.hasColumns());
+  }
+}
+
+TEST(PointFields, AbsoluteTimestampsInSecondsOrNanoseconds) {
+  // Hesai: float64 seconds; Livox 2: float64 nanoseconds. Both absolute, whatever the stamp.
+  for (double scale : {1.0, 1e9}) {
+    Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}, {"timestamp", 16, F::kFloat64}});
+    packer.add({1, 1, 1, 1700000000.25 * scale});
+    const DecodedPoints d = decodePackedPoints(packer.finish(), 0.0);
+    EXPECT_NEAR(d.cloud.times_s[0], 1700000000.25, 1e-6);
+    EXPECT_EQ(d.time_source, PointTimeSource::kAbsoluteField);
+    EXPECT_THAT(d.time_description, HasSubstr(scale == 1.0 ? "in s" : "in ns"));
+  }
+}
+
+TEST(PointFields, LivoxOffsetTimeInNanoseconds) {
+  Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}, {"offset_time", 12, F::kUint32},
+                 {"line", 16, F::kUint8}});
+  packer.add({5, 0, 0, 3e6, 2});
+  const DecodedPoints d = decodePackedPoints(packer.finish(), 10.0);
+  EXPECT_DOUBLE_EQ(d.cloud.times_s[0], 10.003);
+  EXPECT_EQ(d.cloud.rings[0], 2);
+}
+
+TEST(PointFields, WithoutTimeFieldTimesFollowTheClockwiseAzimuth) {
+  Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}});
+  packer.add({1, 0, 0});   // azimuth 0: the start
+  packer.add({0, -1, 0});  // -90 degrees: a quarter turn clockwise later
+  packer.add({-1, 0, 0});  // 180 degrees: half a turn
+  packer.add({0, 1, 0});   // +90 degrees: three quarters
+  const DecodedPoints d = decodePackedPoints(packer.finish(), 2.0, {.scan_period_s = 0.1});
+  EXPECT_EQ(d.time_source, PointTimeSource::kAzimuth);
+  EXPECT_THAT(d.time_description, HasSubstr("no time field"));
+  EXPECT_NEAR(d.cloud.times_s[0], 2.0, 1e-12);
+  EXPECT_NEAR(d.cloud.times_s[1], 2.025, 1e-9);
+  EXPECT_NEAR(d.cloud.times_s[2], 2.05, 1e-9);
+  EXPECT_NEAR(d.cloud.times_s[3], 2.075, 1e-9);
+}
+
+TEST(PointFields, OrganizedWithoutTimeFieldUsesTheColumn) {
+  Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}});
+  for (int i = 0; i < 8; ++i) packer.add({1, 1, 1});
+  const DecodedPoints d = decodePackedPoints(packer.finish(2), 0.0, {.scan_period_s = 0.1});
+  EXPECT_EQ(d.time_source, PointTimeSource::kColumnIndex);
+  EXPECT_NEAR(d.cloud.times_s[3], 0.075, 1e-12);  // column 3 of 4
+  EXPECT_EQ(d.cloud.rings[5], 1);                  // the row stands for the ring
+}
+
+TEST(PointFields, DropsNonFinitePoints) {
+  Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}});
+  packer.add({std::nan(""), 1, 1});
+  packer.add({1, INFINITY, 1});
+  packer.add({1, 1, 1});
+  const DecodedPoints d = decodePackedPoints(packer.finish(), 0.0);
+  EXPECT_EQ(d.cloud.size(), 1u);
+  EXPECT_EQ(d.dropped_invalid, 2u);
+}
+
+TEST(PointFields, RejectsInconsistentLayouts) {
+  Packer good({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}});
+  good.add({1, 2, 3});
+  good.add({1, 2, 3});
+  const PackedPoints base = good.finish();
+
+  PackedPoints outside = base;
+  outside.fields.push_back({"t", 10, F::kUint32});
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(outside, 0); }),
+              HasSubstr("field 't' (offset 10, 1 x uint32) does not fit in point_step 12"));
+
+  PackedPoints short_data = base;
+  short_data.width = 3;
+  short_data.row_step = 36;
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(short_data, 0); }),
+              HasSubstr("data holds 24 bytes but 1 x 3 points of 12 bytes need 36"));
+
+  PackedPoints narrow_rows = base;
+  narrow_rows.row_step = 12;
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(narrow_rows, 0); }), HasSubstr("row_step 12 is smaller"));
+
+  PackedPoints no_z = base;
+  no_z.fields.pop_back();
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(no_z, 0); }), HasSubstr("no x, y and z fields (fields: x:float32 y:float32)"));
+
+  PackedPoints integer_x = base;
+  integer_x.fields[0].type = F::kInt32;
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(integer_x, 0); }), HasSubstr("field 'x' is int32"));
+
+  PackedPoints bad_type = base;
+  bad_type.fields[1].type = static_cast<FieldType>(42);
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(bad_type, 0); }), HasSubstr("unknown datatype 42"));
+
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(base, 0, {.time_field = "stamp"}); }),
+              HasSubstr("the configured time field 'stamp' is not among the fields"));
+
+  PackedPoints zero_step = base;
+  zero_step.point_step = 0;
+  EXPECT_THAT(messageOf<InputError>([&] { decodePackedPoints(zero_step, 0); }), HasSubstr("point_step is 0"));
+}
+
+}  // namespace
+}  // namespace taiga::io
