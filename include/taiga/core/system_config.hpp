@@ -3,15 +3,18 @@
 // modules that own them land.
 
 #include "taiga/core/config.hpp"
+#include "taiga/core/recording_config.hpp"
 #include "taiga/core/rig_config.hpp"
 
 namespace taiga {
 
 struct SystemConfig final : ConfigSection {
   RigConfig rig;
+  RecordingConfig recording;
 
   void visit(ConfigVisitor& v) override {
     v.section("rig", rig, "sensor rig: extrinsics, clock offset and units");
+    v.section("recording", recording, "which streams to read and how to interpret them");
   }
 };
 

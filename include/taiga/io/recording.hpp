@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "taiga/core/point_cloud.hpp"
+#include "taiga/core/recording_config.hpp"
+#include "taiga/core/rig_config.hpp"
 #include "taiga/core/sensor_samples.hpp"
 
 namespace taiga::io {
@@ -42,5 +44,50 @@ class StreamSource {
   /// The next event, or nothing at the end of the stream. Throws InputError on corrupt input.
   virtual std::optional<RecordingEvent> next() = 0;
 };
+
+/// Counts of what a Recording had to repair, for reports and `taiga info`.
+struct RecordingRepairs {
+  std::size_t out_of_order_dropped = 0;  ///< events not after their stream's previous event
+};
+
+/// All streams of a recording merged into one sequence in event-time order.
+///
+/// Within a stream, an event whose time is not after the previous one is dropped with a warning
+/// (drivers occasionally repeat a stamp); a stream that jumps back by more than
+/// kMaxBackwardJump_s is an error, because the recording then mixes clocks. The lidar clock
+/// offset is added to every scan time before merging.
+class Recording {
+ public:
+  static constexpr double kMaxBackwardJump_s = 1.0;
+
+  Recording(std::string source, std::vector<std::unique_ptr<StreamSource>> streams,
+            double lidar_time_offset_s = 0.0);
+  Recording(Recording&&) noexcept;
+  Recording& operator=(Recording&&) noexcept;
+  ~Recording();
+
+  /// The next event in time order, or nothing at the end. Throws InputError on corrupt input.
+  std::optional<RecordingEvent> next();
+
+  /// The file or directory the recording was opened from.
+  const std::string& source() const { return source_; }
+  std::vector<std::string> streamNames() const;
+  const RecordingRepairs& repairs() const { return repairs_; }
+
+ private:
+  struct Stream;
+  void refill(Stream& stream);
+
+  std::string source_;
+  std::vector<Stream> streams_;
+  double lidar_time_offset_s_;
+  RecordingRepairs repairs_;
+};
+
+/// Opens a ROS1 bag (*.bag), an Ouster capture (*.pcap with its metadata JSON) or a folder
+/// recording (a directory, see docs/recordings.md). Throws InputError naming the path and the
+/// problem when it is none of these or cannot be read.
+Recording openRecording(const std::filesystem::path& path, const RecordingConfig& recording,
+                        const RigConfig& rig);
 
 }  // namespace taiga::io

@@ -1,0 +1,26 @@
+#pragma once
+// How to read a recording: which streams to take and how to interpret per-point times.
+
+#include <string>
+
+#include "taiga/core/config.hpp"
+
+namespace taiga {
+
+struct RecordingConfig final : ConfigSection {
+  /// Topics of a ROS bag; empty picks the only topic of the right message type.
+  std::string lidar_topic;
+  std::string imu_topic;
+  std::string gnss_topic;
+  /// Ouster sensor metadata JSON for a pcap; empty looks next to the capture.
+  std::string ouster_metadata;
+  /// Duration of one lidar sweep, s; used when per-point times must be derived from geometry.
+  double scan_period_s = 0.1;
+  /// Point field holding per-point time; empty recognizes t, time, offset_time, timestamp.
+  std::string point_time_field;
+
+  void visit(ConfigVisitor& v) override;
+  void validate() const override;
+};
+
+}  // namespace taiga

@@ -1,0 +1,95 @@
+#include "taiga/io/recording.hpp"
+
+#include <fmt/format.h>
+
+#include <limits>
+
+#include "taiga/core/errors.hpp"
+#include "taiga/core/log.hpp"
+
+namespace taiga::io {
+
+double eventTime(const RecordingEvent& event) {
+  struct {
+    double operator()(const Scan& scan) const { return scan.t_end_s; }
+    double operator()(const ImuSample& imu) const { return imu.t_s; }
+    double operator()(const GnssFix& fix) const { return fix.t_s; }
+  } visitor;
+  return std::visit(visitor, event);
+}
+
+namespace {
+
+void shiftScanTimes(Scan& scan, double offset_s) {
+  scan.t_start_s += offset_s;
+  scan.t_end_s += offset_s;
+  for (double& t : scan.cloud_in_lidar.times_s) t += offset_s;
+}
+
+}  // namespace
+
+struct Recording::Stream {
+  std::unique_ptr<StreamSource> source;
+  std::optional<RecordingEvent> head;  // the next event of this stream, already read
+  double last_time_s = -std::numeric_limits<double>::infinity();
+  bool exhausted = false;
+};
+
+Recording::Recording(std::string source, std::vector<std::unique_ptr<StreamSource>> streams,
+                     double lidar_time_offset_s)
+    : source_(std::move(source)), lidar_time_offset_s_(lidar_time_offset_s) {
+  for (auto& s : streams) streams_.push_back(Stream{std::move(s), std::nullopt});
+}
+
+Recording::Recording(Recording&&) noexcept = default;
+Recording& Recording::operator=(Recording&&) noexcept = default;
+Recording::~Recording() = default;
+
+std::vector<std::string> Recording::streamNames() const {
+  std::vector<std::string> names;
+  for (const Stream& s : streams_) names.push_back(s.source->name());
+  return names;
+}
+
+// Reads the stream's next event that is in time order, dropping (and counting) repeats.
+void Recording::refill(Stream& stream) {
+  while (!stream.head && !stream.exhausted) {
+    std::optional<RecordingEvent> event = stream.source->next();
+    if (!event) {
+      stream.exhausted = true;
+      return;
+    }
+    if (auto* scan = std::get_if<Scan>(&*event)) shiftScanTimes(*scan, lidar_time_offset_s_);
+    const double t_s = eventTime(*event);
+    if (t_s > stream.last_time_s) {
+      stream.last_time_s = t_s;
+      stream.head = std::move(event);
+      return;
+    }
+    if (stream.last_time_s - t_s > kMaxBackwardJump_s) {
+      throw InputError(fmt::format(
+          "{}: {}: time jumps back by {:.3f} s (from {:.6f} to {:.6f} s); the recording mixes clocks or "
+          "joins several recordings",
+          source_, stream.source->name(), stream.last_time_s - t_s, stream.last_time_s, t_s));
+    }
+    if (repairs_.out_of_order_dropped++ < 10) {
+      logger().warn("{}: {}: dropped an event at {:.6f} s that is not after the previous one ({:.6f} s)", source_,
+                    stream.source->name(), t_s, stream.last_time_s);
+    }
+  }
+}
+
+std::optional<RecordingEvent> Recording::next() {
+  Stream* earliest = nullptr;
+  for (Stream& stream : streams_) {
+    refill(stream);
+    // Ties go to the stream listed first, so that the order is the same run after run.
+    if (stream.head && (!earliest || eventTime(*stream.head) < eventTime(*earliest->head))) earliest = &stream;
+  }
+  if (!earliest) return std::nullopt;
+  std::optional<RecordingEvent> event;
+  event.swap(earliest->head);
+  return event;
+}
+
+}  // namespace taiga::io
