@@ -10,7 +10,7 @@ packages=(
   # math, configuration, command line, logging
   libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   # recordings: Ouster captures, ROS1 bags
-  libpcap-dev librosbag-storage-dev libsensor-msgs-dev libstd-msgs-dev
+  libpcap-dev librosbag-storage-dev libsensor-msgs-dev libstd-msgs-dev liblzf-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -73,4 +73,43 @@ void NumericTextReader::failFile(const std::string& message) const {
 
 std::string formatExact(double value) { return fmt::format("{}", value); }
 
+std::optional<double> parseDouble(std::string_view token) {
+  const char* first = token.data();
+  const char* last = token.data() + token.size();
+  if (first != last && *first == '+' && last - first > 1) ++first;  // from_chars rejects '+'
+  double value = 0.0;
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  // Out of range (1e999) is not a number we can use either.
+  if (ec != std::errc() || ptr != last || first == last) return std::nullopt;
+  return value;
+}
+
+double parseNumber(std::string_view token, const std::string& context) {
+  if (auto value = parseDouble(token)) return *value;
+  throw InputError(fmt::format("{}: '{}' is not a number", context, token));
+}
+
+std::vector<std::string> splitWords(std::string_view line) {
+  std::vector<std::string> words;
+  std::size_t pos = 0;
+  while (pos < line.size()) {
+    while (pos < line.size() && isSpace(line[pos])) ++pos;
+    std::size_t end = pos;
+    while (end < line.size() && !isSpace(line[end])) ++end;
+    if (end > pos) words.emplace_back(line.substr(pos, end - pos));
+    pos = end;
+  }
+  return words;
+}
+
+std::string readWholeFile(const std::filesystem::path& path) {
+  if (!std::filesystem::is_regular_file(path)) {
+    throw InputError(fmt::format("{}: {}", path.string(), std::filesystem::exists(path) ? "is not a regular file" : "no such file"));
+  }
+  std::ifstream stream(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  if (stream.bad()) throw InputError(fmt::format("{}: read error", path.string()));
+  return text;
+}
+
 }  // namespace taiga::io::detail

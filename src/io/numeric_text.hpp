@@ -4,7 +4,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace taiga::io::detail {
@@ -36,5 +38,14 @@ class NumericTextReader {
 
 /// The shortest text that reads back as exactly `value`.
 std::string formatExact(double value);
+
+/// The number written in `token` (a leading '+' allowed, "nan" and "inf" accepted), or nothing.
+std::optional<double> parseDouble(std::string_view token);
+/// parseDouble or InputError("CONTEXT: 'TOKEN' is not a number").
+double parseNumber(std::string_view token, const std::string& context);
+/// The words of `line` separated by spaces, tabs or carriage returns.
+std::vector<std::string> splitWords(std::string_view line);
+/// The whole content of a file; InputError naming the file when it cannot be read.
+std::string readWholeFile(const std::filesystem::path& path);
 
 }  // namespace taiga::io::detail

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cassert>
 #include <cstring>
+#include <limits>
 #include <numbers>
 
 #include "taiga/core/errors.hpp"
@@ -13,8 +15,9 @@
 namespace taiga::io {
 namespace {
 
-// Reads one element of `type` at `p` as a double, swapping bytes for big-endian data.
-double readValue(const std::uint8_t* p, FieldType type, bool swap) {
+}  // namespace
+
+double unpackValue(const std::uint8_t* p, FieldType type, bool swap) {
   std::uint8_t bytes[8];
   const std::size_t size = fieldTypeSize(type);
   std::memcpy(bytes, p, size);
@@ -33,9 +36,13 @@ double readValue(const std::uint8_t* p, FieldType type, bool swap) {
     case FieldType::kUint32: return as(std::uint32_t{});
     case FieldType::kFloat32: return as(float{});
     case FieldType::kFloat64: return as(double{});
+    case FieldType::kInt64: return as(std::int64_t{});
+    case FieldType::kUint64: return as(std::uint64_t{});
   }
   return std::nan("");
 }
+
+namespace {
 
 bool isInteger(FieldType type) { return type != FieldType::kFloat32 && type != FieldType::kFloat64; }
 
@@ -135,7 +142,9 @@ std::size_t fieldTypeSize(FieldType type) {
     case FieldType::kInt32:
     case FieldType::kUint32:
     case FieldType::kFloat32: return 4;
-    case FieldType::kFloat64: return 8;
+    case FieldType::kFloat64:
+    case FieldType::kInt64:
+    case FieldType::kUint64: return 8;
   }
   return 0;
 }
@@ -150,8 +159,47 @@ std::string fieldTypeName(FieldType type) {
     case FieldType::kUint32: return "uint32";
     case FieldType::kFloat32: return "float32";
     case FieldType::kFloat64: return "float64";
+    case FieldType::kInt64: return "int64";
+    case FieldType::kUint64: return "uint64";
   }
   return fmt::format("type{}", static_cast<int>(type));
+}
+
+bool fitsFieldType(FieldType type, double value) {
+  auto within = []<class T>(T, double v) {
+    return std::isfinite(v) && v == std::trunc(v) && v >= static_cast<double>(std::numeric_limits<T>::lowest()) &&
+           v < std::ldexp(1.0, std::numeric_limits<T>::digits) ;
+  };
+  switch (type) {
+    case FieldType::kInt8: return within(std::int8_t{}, value);
+    case FieldType::kUint8: return within(std::uint8_t{}, value);
+    case FieldType::kInt16: return within(std::int16_t{}, value);
+    case FieldType::kUint16: return within(std::uint16_t{}, value);
+    case FieldType::kInt32: return within(std::int32_t{}, value);
+    case FieldType::kUint32: return within(std::uint32_t{}, value);
+    case FieldType::kInt64: return within(std::int64_t{}, value);
+    case FieldType::kUint64: return within(std::uint64_t{}, value);
+    case FieldType::kFloat32:
+    case FieldType::kFloat64: return true;
+  }
+  return false;
+}
+
+void packValue(std::uint8_t* p, FieldType type, double value) {
+  assert(fitsFieldType(type, value));
+  auto put = [p]<class T>(T typed) { std::memcpy(p, &typed, sizeof(T)); };
+  switch (type) {
+    case FieldType::kInt8: put(static_cast<std::int8_t>(value)); break;
+    case FieldType::kUint8: put(static_cast<std::uint8_t>(value)); break;
+    case FieldType::kInt16: put(static_cast<std::int16_t>(value)); break;
+    case FieldType::kUint16: put(static_cast<std::uint16_t>(value)); break;
+    case FieldType::kInt32: put(static_cast<std::int32_t>(value)); break;
+    case FieldType::kUint32: put(static_cast<std::uint32_t>(value)); break;
+    case FieldType::kFloat32: put(static_cast<float>(value)); break;
+    case FieldType::kFloat64: put(value); break;
+    case FieldType::kInt64: put(static_cast<std::int64_t>(value)); break;
+    case FieldType::kUint64: put(static_cast<std::uint64_t>(value)); break;
+  }
 }
 
 std::string describeFields(const std::vector<PointField>& fields) {
@@ -193,15 +241,15 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
   for (std::uint32_t row = 0; row < points.height; ++row) {
     for (std::uint32_t col = 0; col < points.width; ++col) {
       const std::uint8_t* record = points.data.data() + std::size_t{row} * points.row_step + std::size_t{col} * points.point_step;
-      const Eigen::Vector3d p(readValue(record + fx->offset, fx->type, swap), readValue(record + fy->offset, fy->type, swap),
-                              readValue(record + fz->offset, fz->type, swap));
+      const Eigen::Vector3d p(unpackValue(record + fx->offset, fx->type, swap), unpackValue(record + fy->offset, fy->type, swap),
+                              unpackValue(record + fz->offset, fz->type, swap));
       if (!p.allFinite() || p.isZero(0.0)) {
         ++out.dropped_invalid;
         continue;
       }
       double t_s = stamp_s;
       if (time_rule.field) {
-        const double value = readValue(record + time_rule.field->offset, time_rule.field->type, swap);
+        const double value = unpackValue(record + time_rule.field->offset, time_rule.field->type, swap);
         if (time_rule.absolute) {
           if (absolute_scale == 0.0) absolute_scale = absoluteScale(std::abs(value));
           t_s = value * absolute_scale;
@@ -221,9 +269,9 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
       }
       cloud.positions.push_back(p);
       cloud.times_s.push_back(t_s);
-      if (f_intensity) cloud.intensities.push_back(static_cast<float>(readValue(record + f_intensity->offset, f_intensity->type, swap)));
+      if (f_intensity) cloud.intensities.push_back(static_cast<float>(unpackValue(record + f_intensity->offset, f_intensity->type, swap)));
       if (f_ring) {
-        cloud.rings.push_back(static_cast<std::uint16_t>(readValue(record + f_ring->offset, f_ring->type, swap)));
+        cloud.rings.push_back(static_cast<std::uint16_t>(unpackValue(record + f_ring->offset, f_ring->type, swap)));
       } else if (organized) {
         cloud.rings.push_back(static_cast<std::uint16_t>(row));
       }

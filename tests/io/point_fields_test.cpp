@@ -44,20 +44,8 @@ class Packer {
 
  private:
   void write(std::uint8_t* p, FieldType type, double value) {
-    auto put = [&]<class T>(T typed) {
-      std::memcpy(p, &typed, sizeof(T));
-      if (big_endian_) std::reverse(p, p + sizeof(T));
-    };
-    switch (type) {
-      case FieldType::kInt8: put(static_cast<std::int8_t>(value)); break;
-      case FieldType::kUint8: put(static_cast<std::uint8_t>(value)); break;
-      case FieldType::kInt16: put(static_cast<std::int16_t>(value)); break;
-      case FieldType::kUint16: put(static_cast<std::uint16_t>(value)); break;
-      case FieldType::kInt32: put(static_cast<std::int32_t>(value)); break;
-      case FieldType::kUint32: put(static_cast<std::uint32_t>(value)); break;
-      case FieldType::kFloat32: put(static_cast<float>(value)); break;
-      case FieldType::kFloat64: put(value); break;
-    }
+    packValue(p, type, value);
+    if (big_endian_) std::reverse(p, p + fieldTypeSize(type));
   }
   PackedPoints points_;
   std::vector<std::uint8_t> bytes_;

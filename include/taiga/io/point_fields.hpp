@@ -23,7 +23,8 @@
 
 namespace taiga::io {
 
-/// Field data types, with the numbering of sensor_msgs/PointField.
+/// Field data types, with the numbering of sensor_msgs/PointField; the 64-bit integers (which
+/// PCD and PLY files may hold) extend it.
 enum class FieldType : std::uint8_t {
   kInt8 = 1,
   kUint8 = 2,
@@ -33,12 +34,25 @@ enum class FieldType : std::uint8_t {
   kUint32 = 6,
   kFloat32 = 7,
   kFloat64 = 8,
+  kInt64 = 9,
+  kUint64 = 10,
 };
 
 /// Size in bytes of one element of `type`; 0 for a value outside the enumeration.
 std::size_t fieldTypeSize(FieldType type);
 /// "uint16", "float32", ...
 std::string fieldTypeName(FieldType type);
+
+/// Reads one element of `type` at `p` as a double, swapping the bytes when `swap_bytes`.
+double unpackValue(const std::uint8_t* p, FieldType type, bool swap_bytes);
+
+/// True when `value` can be stored as `type`: any value (NaN included) for the float types, a
+/// whole number within the type's range for the integer types.
+bool fitsFieldType(FieldType type, double value);
+
+/// Writes `value` at `p` as one element of `type` in native byte order. Requires
+/// fitsFieldType(type, value).
+void packValue(std::uint8_t* p, FieldType type, double value);
 
 struct PointField {
   std::string name;

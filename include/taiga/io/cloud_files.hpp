@@ -1,0 +1,41 @@
+#pragma once
+// Point-cloud files: PCD (ascii, binary, binary_compressed) and PLY (ascii, binary little and big
+// endian) in; PLY out. Reading turns a file into packed points (point_fields.hpp), so files and
+// ROS messages share one decoder and one set of time conventions.
+//
+// Errors are InputErrors naming the file and, where there is one, the header line or field.
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "taiga/core/point_cloud.hpp"
+#include "taiga/io/point_fields.hpp"
+
+namespace taiga::io {
+
+/// Packed points that own their bytes (`packed.data` views `bytes`).
+struct LoadedPoints {
+  std::vector<std::uint8_t> bytes;
+  PackedPoints packed;
+
+  LoadedPoints() = default;
+  LoadedPoints(LoadedPoints&& other) noexcept;
+  LoadedPoints& operator=(LoadedPoints&& other) noexcept;
+};
+
+LoadedPoints readPcd(const std::filesystem::path& path);
+LoadedPoints readPly(const std::filesystem::path& path);
+/// PCD or PLY by extension (.pcd, .ply, case-insensitive).
+LoadedPoints readCloudFile(const std::filesystem::path& path);
+
+/// Reads and decodes a PCD or PLY file; `stamp_s` is the time relative per-point times count from.
+DecodedPoints readPointCloudFile(const std::filesystem::path& path, double stamp_s,
+                                 const PointDecodeOptions& options = {});
+
+/// Writes binary little-endian PLY with x, y, z as float64 (so georeferenced coordinates keep
+/// full precision) and whichever of time (float64, s), intensity (float32), ring and column
+/// (uint16) the cloud carries. CloudCompare, MeshLab and lidR read it.
+void writePly(const std::filesystem::path& path, const PointCloud& cloud);
+
+}  // namespace taiga::io
