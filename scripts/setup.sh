@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Installs every Debian package taiga needs to build, test and benchmark.
+# Installs every Debian package taiga needs to build, test and benchmark, and the Node.js package
+# that tests use as an independent LAS reader (tools/las-check).
 # Idempotent and non-interactive: installs only what is missing, runs `apt-get update` first when it
 # has to install anything. Uses sudo when not run as root.
 set -euo pipefail
+cd "$(dirname "$0")/.."
 
 packages=(
   # toolchain
@@ -14,6 +16,10 @@ packages=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )
+# Node.js runs the independent LAS reader in tests; any Node.js >= 18 on the PATH will do.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for package in "${packages[@]}"; do
@@ -22,8 +28,18 @@ for package in "${packages[@]}"; do
   fi
 done
 
+install_node_tools() {
+  local dir=tools/las-check
+  if [ ! -d "$dir/node_modules" ] || [ "$dir/package-lock.json" -nt "$dir/node_modules" ]; then
+    echo "setup: installing the Node.js packages of $dir"
+    (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+    touch "$dir/node_modules"
+  fi
+}
+
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} Debian packages are installed"
+  install_node_tools
   exit 0
 fi
 
@@ -40,3 +56,4 @@ echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update -qq
 "${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+install_node_tools
