@@ -6,6 +6,8 @@
 
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
+#include "taiga/io/folder_recording.hpp"
+#include "taiga/io/rosbag.hpp"
 
 namespace taiga::io {
 
@@ -90,6 +92,26 @@ std::optional<RecordingEvent> Recording::next() {
   std::optional<RecordingEvent> event;
   event.swap(earliest->head);
   return event;
+}
+
+Recording openRecording(const std::filesystem::path& path, const RecordingConfig& recording, const RigConfig& rig) {
+  if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: no such file or directory", path.string()));
+  std::vector<std::unique_ptr<StreamSource>> streams;
+  if (std::filesystem::is_directory(path)) {
+    if (!isFolderRecording(path)) {
+      throw InputError(fmt::format("{}: a directory without scans/ or imu.csv is not a folder recording (see "
+                                   "docs/recordings.md)",
+                                   path.string()));
+    }
+    streams = openFolderStreams(path, recording, rig);
+  } else if (path.extension() == ".bag") {
+    streams = openBagStreams(path, recording, rig);
+  } else {
+    throw InputError(fmt::format("{}: not a recording taiga reads: expected a ROS1 bag (.bag), an Ouster capture "
+                                 "(.pcap) or a folder recording",
+                                 path.string()));
+  }
+  return Recording(path.string(), std::move(streams), rig.lidar_time_offset_s);
 }
 
 }  // namespace taiga::io
