@@ -32,6 +32,7 @@ class FolderScanStream final : public StreamSource {
       : files_(std::move(files)), options_{config.scan_period_s, config.point_time_field} {}
 
   std::string name() const override { return "scans/"; }
+  std::vector<std::string> details() const override { return details_; }
 
   std::optional<RecordingEvent> next() override {
     while (next_ < files_.size()) {
@@ -39,6 +40,7 @@ class FolderScanStream final : public StreamSource {
       DecodedPoints decoded = readPointCloudFile(file.path, file.stamp_s, options_);
       if (!reported_times_) {
         reported_times_ = true;
+        details_ = {fmt::format("{} scan files", files_.size()), fmt::format("per-point times: {}", decoded.time_description)};
         const bool guessed = decoded.time_source == PointTimeSource::kAzimuth || decoded.time_source == PointTimeSource::kColumnIndex;
         logger().log(guessed ? spdlog::level::warn : spdlog::level::info, "{}: per-point times: {}",
                      file.path.parent_path().string(), decoded.time_description);
@@ -62,6 +64,7 @@ class FolderScanStream final : public StreamSource {
   std::size_t next_ = 0;
   std::uint64_t scan_count_ = 0;
   bool reported_times_ = false;
+  std::vector<std::string> details_;
 };
 
 class ImuCsvStream final : public StreamSource {

@@ -44,6 +44,11 @@ class ScaledImuStream final : public StreamSource {
       : raw_(std::move(raw)), configured_(configured), source_(std::move(source)) {}
 
   std::string name() const override { return raw_->name(); }
+  std::vector<std::string> details() const override {
+    std::vector<std::string> out = raw_->details();
+    if (decision_) out.push_back(decision_->explanation);
+    return out;
+  }
 
   std::optional<RecordingEvent> next() override {
     if (!decision_) decide();

@@ -53,6 +53,14 @@ std::vector<std::string> Recording::streamNames() const {
   return names;
 }
 
+std::vector<std::string> Recording::streamDetails() const {
+  std::vector<std::string> out;
+  for (const Stream& s : streams_) {
+    for (const std::string& detail : s.source->details()) out.push_back(s.source->name() + ": " + detail);
+  }
+  return out;
+}
+
 // Reads the stream's next event that is in time order, dropping (and counting) repeats.
 void Recording::refill(Stream& stream) {
   while (!stream.head && !stream.exhausted) {
@@ -81,7 +89,7 @@ void Recording::refill(Stream& stream) {
   }
 }
 
-std::optional<RecordingEvent> Recording::next() {
+std::optional<RecordingEvent> Recording::next(std::size_t* stream_index) {
   Stream* earliest = nullptr;
   for (Stream& stream : streams_) {
     refill(stream);
@@ -89,6 +97,7 @@ std::optional<RecordingEvent> Recording::next() {
     if (stream.head && (!earliest || eventTime(*stream.head) < eventTime(*earliest->head))) earliest = &stream;
   }
   if (!earliest) return std::nullopt;
+  if (stream_index) *stream_index = static_cast<std::size_t>(earliest - streams_.data());
   std::optional<RecordingEvent> event;
   event.swap(earliest->head);
   return event;

@@ -7,7 +7,13 @@
 #include <cstdio>
 #include <string>
 
+#include <fmt/format.h>
+
+#include <nlohmann/json.hpp>
+
 #include "../support/temp_dir.hpp"
+#include "taiga/io/cloud_files.hpp"
+#include "taiga/io/rosbag.hpp"
 
 namespace {
 
@@ -15,11 +21,11 @@ using ::testing::HasSubstr;
 
 struct Result {
   int exit_code;
-  std::string output;  // standard output and standard error together
+  std::string output;  // standard output, and standard error unless dropped
 };
 
-Result runTaiga(const std::string& arguments) {
-  const std::string command = std::string(TAIGA_EXECUTABLE) + " " + arguments + " 2>&1";
+Result runTaiga(const std::string& arguments, bool keep_stderr = true) {
+  const std::string command = std::string(TAIGA_EXECUTABLE) + " " + arguments + (keep_stderr ? " 2>&1" : " 2>/dev/null");
   std::FILE* pipe = popen(command.c_str(), "r");
   Result result{-1, ""};
   if (!pipe) return result;
@@ -55,6 +61,89 @@ TEST(Cli, UsageErrorsExitWithTwo) {
   const Result bad_choice = runTaiga("register a.ply b.ply --method icp");
   EXPECT_EQ(bad_choice.exit_code, 2);
   EXPECT_THAT(bad_choice.output, HasSubstr("icp not in {ndt,d2d,gicp}"));
+}
+
+// One second of a small recording: 10 scans of 64 points, 200 IMU samples in g, one fix.
+void writeSmallBag(const std::filesystem::path& path) {
+  using namespace taiga;
+  io::BagWriter writer(path);
+  for (int i = 0; i < 200; ++i) {
+    ImuSample imu;
+    imu.t_s = 1700000000.0 + 0.005 * i;
+    imu.acceleration_imu_mps2 = {0.0, 0.0, 1.0};  // in g, as some drivers publish
+    writer.writeImu("/imu", "imu", imu);
+  }
+  for (int s = 0; s < 10; ++s) {
+    io::Scan scan;
+    scan.index = s;
+    for (int c = 0; c < 64; ++c) {
+      scan.cloud_in_lidar.positions.emplace_back(5.0, 0.1 * c, 1.0);
+      scan.cloud_in_lidar.times_s.push_back(1700000000.0 + 0.1 * s + 0.099 * c / 63);
+      scan.cloud_in_lidar.intensities.push_back(float(c));
+      scan.cloud_in_lidar.rings.push_back(static_cast<std::uint16_t>(c % 16));
+    }
+    std::tie(scan.t_start_s, scan.t_end_s) = scan.cloud_in_lidar.timeSpan();
+    writer.writeScan("/os_cloud_node/points", "os_sensor", scan);
+  }
+}
+
+TEST(Cli, InfoSummarizesABagAsTextAndJson) {
+  taiga::test::TempDir dir;
+  writeSmallBag(dir.file("small.bag"));
+  const Result text = runTaiga("info " + dir.file("small.bag").string());
+  EXPECT_EQ(text.exit_code, 0) << text.output;
+  EXPECT_THAT(text.output, HasSubstr("(ROS1 bag)"));
+  EXPECT_THAT(text.output, HasSubstr("/os_cloud_node/points"));
+  EXPECT_THAT(text.output, HasSubstr("per-point times: field 't' (uint32, ns after the stamp)"));
+  EXPECT_THAT(text.output, HasSubstr("acceleration is in g"));
+
+  const Result json = runTaiga("info --json " + dir.file("small.bag").string(), false);
+  ASSERT_EQ(json.exit_code, 0) << json.output;
+  const auto j = nlohmann::json::parse(json.output);
+  EXPECT_EQ(j["streams"][0]["count"], 10);
+  EXPECT_NEAR(j["streams"][0]["rate_hz"].get<double>(), 10.0, 1e-3);  // stamps are whole ns
+  EXPECT_NEAR(j["streams"][1]["rate_hz"].get<double>(), 200.0, 1e-3);
+  EXPECT_EQ(j["scans"]["median_points"], 64);
+  EXPECT_EQ(j["scans"]["scans_with_monotonic_times"], 10);
+  EXPECT_NEAR(j["imu"]["median_acceleration_mps2"].get<double>(), 9.80665, 1e-9);
+  EXPECT_TRUE(j["error"].is_null());
+}
+
+TEST(Cli, InfoWarnsAboutTimesThatDoNotSpanTheScan) {
+  taiga::test::TempDir dir;
+  std::filesystem::create_directories(dir.file("rec/scans"));
+  // Per-point times in microseconds given where nanoseconds are expected: 1000x too short.
+  for (int s = 0; s < 5; ++s) {
+    std::string pcd = "FIELDS x y z t\nSIZE 4 4 4 4\nTYPE F F F U\nWIDTH 10\nPOINTS 10\nDATA ascii\n";
+    for (int i = 0; i < 10; ++i) pcd += fmt::format("{} 1 1 {}\n", i + 1, i * 10000);
+    dir.write(fmt::format("rec/scans/{}.pcd", 100.0 + 0.1 * s), pcd);
+  }
+  dir.write("rec/imu.csv", "t_s,ax,ay,az,wx,wy,wz\n100,0,0,9.8,0,0,0\n100.5,0,0,9.8,0,0,0\n");
+  const Result r = runTaiga("info " + dir.file("rec").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("(folder recording)"));
+  EXPECT_THAT(r.output, HasSubstr("per-point times span 0.0001 s per scan (median) but scans come every 0.1000 s"));
+}
+
+TEST(Cli, ExportWritesOneScanOrAll) {
+  taiga::test::TempDir dir;
+  writeSmallBag(dir.file("small.bag"));
+  const Result one = runTaiga("export " + dir.file("small.bag").string() + " --scan 3 --out " + dir.file("s3.ply").string());
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  const taiga::io::DecodedPoints points = taiga::io::readPointCloudFile(dir.file("s3.ply"), 0.0);
+  EXPECT_EQ(points.cloud.size(), 64u);
+  EXPECT_NEAR(points.cloud.times_s.front(), 1700000000.3, 1e-6);
+
+  const Result all = runTaiga("export " + dir.file("small.bag").string() + " --all --format las --out " + dir.file("all").string());
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("all/scan_000009.las")));
+
+  const Result missing = runTaiga("export " + dir.file("small.bag").string() + " --scan 10 --out " + dir.file("x.ply").string());
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_THAT(missing.output, HasSubstr("has no scan 10 (scans are numbered from 0)"));
+  const Result no_topic = runTaiga("info " + dir.file("s3.ply").string());
+  EXPECT_EQ(no_topic.exit_code, 2);
+  EXPECT_THAT(no_topic.output, HasSubstr("not a recording taiga reads"));
 }
 
 TEST(Cli, UnbuiltSubcommandsSaySoAndFail) {

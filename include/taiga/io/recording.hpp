@@ -43,6 +43,9 @@ class StreamSource {
   virtual std::string name() const = 0;
   /// The next event, or nothing at the end of the stream. Throws InputError on corrupt input.
   virtual std::optional<RecordingEvent> next() = 0;
+  /// What the stream found out about its data once it has delivered events, for `taiga info`:
+  /// e.g. the point fields and how per-point times were read, or the IMU's acceleration unit.
+  virtual std::vector<std::string> details() const { return {}; }
 };
 
 /// Counts of what a Recording had to repair, for reports and `taiga info`.
@@ -67,11 +70,14 @@ class Recording {
   ~Recording();
 
   /// The next event in time order, or nothing at the end. Throws InputError on corrupt input.
-  std::optional<RecordingEvent> next();
+  /// `stream_index`, when given, receives the index (in streamNames()) of the event's stream.
+  std::optional<RecordingEvent> next(std::size_t* stream_index = nullptr);
 
   /// The file or directory the recording was opened from.
   const std::string& source() const { return source_; }
   std::vector<std::string> streamNames() const;
+  /// details() of every stream, prefixed with the stream's name.
+  std::vector<std::string> streamDetails() const;
   const RecordingRepairs& repairs() const { return repairs_; }
 
  private:

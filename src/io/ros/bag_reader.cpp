@@ -112,6 +112,7 @@ class BagDemux {
   }
 
   const std::filesystem::path& path() const { return path_; }
+  const std::vector<std::string>& details(const std::string& topic) { return details_[topic]; }
 
  private:
   std::optional<RecordingEvent> convert(const rosbag::MessageInstance& m) {
@@ -132,6 +133,11 @@ class BagDemux {
     DecodedPoints decoded = decodePackedPoints(packedPointsOf(*msg), toSeconds(msg->header.stamp), point_options_);
     if (!warned_time_source_) {
       warned_time_source_ = true;
+      const PackedPoints packed = packedPointsOf(*msg);
+      details_[m.getTopic()] = {fmt::format("point fields: {}", describeFields(packed.fields)),
+                                fmt::format("cloud layout: {} x {}{}", packed.height, packed.width,
+                                            packed.height > 1 ? " (organized)" : ""),
+                                fmt::format("per-point times: {}", decoded.time_description)};
       const bool guessed = decoded.time_source == PointTimeSource::kAzimuth ||
                            decoded.time_source == PointTimeSource::kColumnIndex;
       if (guessed) {
@@ -158,6 +164,7 @@ class BagDemux {
   rosbag::View::iterator it_;
   PointDecodeOptions point_options_;
   std::map<std::string, std::deque<RecordingEvent>> queues_;
+  std::map<std::string, std::vector<std::string>> details_;
   std::uint64_t scan_count_ = 0;
   std::size_t empty_scans_ = 0;
   std::size_t invalid_fixes_ = 0;
@@ -169,6 +176,7 @@ class BagStream final : public StreamSource {
   BagStream(std::shared_ptr<BagDemux> demux, std::string topic) : demux_(std::move(demux)), topic_(std::move(topic)) {}
   std::string name() const override { return topic_; }
   std::optional<RecordingEvent> next() override { return demux_->next(topic_); }
+  std::vector<std::string> details() const override { return demux_->details(topic_); }
 
  private:
   std::shared_ptr<BagDemux> demux_;
