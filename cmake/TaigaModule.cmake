@@ -4,7 +4,10 @@
 # 105593 and relatives), so that one is off too (-Wuninitialized stays on).
 function(taiga_set_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
-                                           -Wno-missing-field-initializers -Wno-maybe-uninitialized -Werror)
+                                           -Wno-missing-field-initializers -Werror)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(${target} PRIVATE -Wno-maybe-uninitialized)
+  endif()
 endfunction()
 
 # taiga_add_module(NAME DEPENDS <public deps> PRIVATE_DEPENDS <private deps>)

@@ -18,7 +18,6 @@ namespace taiga::io {
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 // A quaternion typed by hand with a few decimals is normalized; one further from unit length is
 // more likely a mistake (wrong order, a missing component) and is rejected.
 constexpr double kQuaternionNormTolerance = 1e-2;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "taiga/core/point_cloud.hpp"
@@ -26,6 +27,9 @@ struct LoadedPoints {
 
 LoadedPoints readPcd(const std::filesystem::path& path);
 LoadedPoints readPly(const std::filesystem::path& path);
+/// The same from the bytes of a file (for tests and fuzzing); errors carry no file name.
+LoadedPoints parsePcd(const std::string& bytes);
+LoadedPoints parsePly(const std::string& bytes);
 /// PCD or PLY by extension (.pcd, .ply, case-insensitive).
 LoadedPoints readCloudFile(const std::filesystem::path& path);
 

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang (address and undefined-behaviour sanitizers) into
+# build-fuzz/ and runs each for SECONDS (default 20), starting from real files as seeds. A crash,
+# a sanitizer report or a hang fails the script and leaves the input in build-fuzz/findings/.
+# Usage: scripts/fuzz.sh [SECONDS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-20}
+
+if [ ! -f build-fuzz/CMakeCache.txt ]; then
+  CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DTAIGA_BUILD_FUZZERS=ON -DTAIGA_BUILD_TESTS=OFF > /dev/null
+fi
+targets=$(find fuzz -name 'fuzz_*.cpp' | xargs -n1 basename | sed 's/\.cpp$//' | sort)
+cmake --build build-fuzz --parallel "$(nproc)" --target $targets
+
+seed() {  # seed corpus of a target: small real files it should parse
+  local corpus=build-fuzz/corpus/$1
+  mkdir -p "$corpus"
+  case $1 in
+    fuzz_cloud_files)
+      printf '\000FIELDS x y z t\nSIZE 4 4 4 4\nTYPE F F F U\nWIDTH 2\nPOINTS 2\nDATA ascii\n1 2 3 0\n4 5 6 100\n' > "$corpus/ascii_pcd"
+      printf '\001ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n' > "$corpus/ascii_ply"
+      { printf '\001'; head -c 2000 ../shared/data/registration/source.ply; } > "$corpus/binary_ply" 2>/dev/null || true ;;
+    fuzz_ouster_packets)
+      for json in ../shared/data/ouster/*.json; do
+        [ -f "$json" ] && { printf '\000'; cat "$json"; } > "$corpus/$(basename "$json")"
+      done
+      head -c 4096 /dev/zero | tr '\000' '\001' > "$corpus/packets" ;;
+  esac
+  echo "$corpus"
+}
+
+mkdir -p build-fuzz/findings
+for target in $targets; do
+  echo "fuzz: $target for $seconds s"
+  corpus=$(seed "$target")
+  build-fuzz/bin/$target "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=0 \
+    -artifact_prefix=build-fuzz/findings/"$target"- 2>&1 | tail -n 3
+done
+echo "fuzz: no crash in $(echo $targets | wc -w) targets"
