@@ -13,6 +13,10 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   # recordings: Ouster captures, ROS1 bags
   libpcap-dev librosbag-storage-dev libsensor-msgs-dev libstd-msgs-dev liblzf-dev
+  # estimation, parallel loops, nearest neighbours, geodesy, ray casting for the simulator
+  libceres-dev libtbb-dev libnanoflann-dev libproj-dev proj-data libembree-dev
+  # reference implementations (PCL's NDT/GICP) for tests and benchmarks, plots
+  libpcl-dev python3-matplotlib
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -7,6 +7,7 @@
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/io/folder_recording.hpp"
+#include "taiga/io/ouster/capture.hpp"
 #include "taiga/io/rosbag.hpp"
 
 namespace taiga::io {
@@ -103,6 +104,46 @@ std::optional<RecordingEvent> Recording::next(std::size_t* stream_index) {
   return event;
 }
 
+namespace {
+
+/// The metadata JSON of an Ouster capture: the configured one, else one beside the capture whose
+/// name is the capture's name or its beginning (Ouster's tools save `NAME.json` with `NAME.pcap`,
+/// `NAME_0.json` with a sensor index, or one JSON for several captures `NAME_part.pcap`).
+std::filesystem::path findOusterMetadata(const std::filesystem::path& pcap, const RecordingConfig& recording) {
+  if (!recording.ouster_metadata.empty()) {
+    if (!std::filesystem::exists(recording.ouster_metadata)) {
+      throw InputError(fmt::format("{}: no such file (recording.ouster_metadata, the sensor metadata for {})",
+                                   recording.ouster_metadata, pcap.string()));
+    }
+    return recording.ouster_metadata;
+  }
+  const std::string stem = pcap.stem().string();
+  for (const std::string& name : {stem + ".json", stem + "_0.json"}) {
+    const std::filesystem::path candidate = pcap.parent_path() / name;
+    if (std::filesystem::exists(candidate)) return candidate;
+  }
+  std::filesystem::path best;
+  std::size_t best_length = 0;
+  const std::filesystem::path dir = pcap.parent_path().empty() ? "." : pcap.parent_path();
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".json") continue;
+    const std::string json_stem = entry.path().stem().string();
+    if (json_stem.size() > best_length && stem.starts_with(json_stem)) {
+      best = entry.path();
+      best_length = json_stem.size();
+    }
+  }
+  if (best.empty()) {
+    throw InputError(fmt::format("{}: an Ouster capture needs the sensor metadata JSON saved with it; none found "
+                                 "beside it ({}.json, {}_0.json); give it with recording.ouster_metadata",
+                                 pcap.string(), stem, stem));
+  }
+  logger().info("{}: using the sensor metadata {}", pcap.string(), best.string());
+  return best;
+}
+
+}  // namespace
+
 Recording openRecording(const std::filesystem::path& path, const RecordingConfig& recording, const RigConfig& rig) {
   if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: no such file or directory", path.string()));
   std::vector<std::unique_ptr<StreamSource>> streams;
@@ -115,6 +156,8 @@ Recording openRecording(const std::filesystem::path& path, const RecordingConfig
     streams = openFolderStreams(path, recording, rig);
   } else if (path.extension() == ".bag") {
     streams = openBagStreams(path, recording, rig);
+  } else if (path.extension() == ".pcap" || path.extension() == ".pcapng") {
+    streams = ouster::openOusterCapture(path, findOusterMetadata(path, recording));
   } else {
     throw InputError(fmt::format("{}: not a recording taiga reads: expected a ROS1 bag (.bag), an Ouster capture "
                                  "(.pcap) or a folder recording",

@@ -92,10 +92,12 @@ void addWarnings(RecordingSummary& s, const std::vector<std::size_t>& points_per
   if (!lidar || lidar->count == 0) s.warnings.push_back("no scans");
   if (!imu || imu->count == 0) s.warnings.push_back("no IMU samples: taiga run needs an IMU");
   if (lidar && imu && lidar->count > 0 && imu->count > 0) {
-    if (lidar->first_s > imu->last_s || imu->first_s > lidar->last_s) {
+    // Scans are listed by their start; the last one lasts until its last point.
+    const double lidar_end_s = lidar->last_s + s.scans.median_span_s;
+    if (lidar->first_s > imu->last_s || imu->first_s > lidar_end_s) {
       s.warnings.push_back(fmt::format("the lidar ({:.3f} .. {:.3f} s) and IMU ({:.3f} .. {:.3f} s) times do not overlap: "
                                        "different clocks? set rig.lidar_time_offset_s or fix the driver's time source",
-                                       lidar->first_s, lidar->last_s, imu->first_s, imu->last_s));
+                                       lidar->first_s, lidar_end_s, imu->first_s, imu->last_s));
     } else if (std::abs(lidar->first_s - imu->first_s) > 1.0) {
       s.warnings.push_back(fmt::format("the lidar and IMU streams start {:.3f} s apart", lidar->first_s - imu->first_s));
     }
