@@ -35,7 +35,7 @@ mkdir -p build-fuzz/findings
 for target in $targets; do
   echo "fuzz: $target for $seconds s"
   corpus=$(seed "$target")
-  build-fuzz/bin/$target "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=0 \
+  build-fuzz/bin/$target "$corpus" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 -print_final_stats=0 \
     -artifact_prefix=build-fuzz/findings/"$target"- 2>&1 | tail -n 3
 done
 echo "fuzz: no crash in $(echo $targets | wc -w) targets"

@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
+#include <map>
 #include <string>
 
 #include <fmt/format.h>
@@ -107,6 +109,28 @@ TEST(Cli, InfoSummarizesABagAsTextAndJson) {
   EXPECT_EQ(j["scans"]["scans_with_monotonic_times"], 10);
   EXPECT_NEAR(j["imu"]["median_acceleration_mps2"].get<double>(), 9.80665, 1e-9);
   EXPECT_TRUE(j["error"].is_null());
+}
+
+TEST(Cli, InfoReadsAnOusterCaptureWithTheMetadataBesideIt) {
+  // The OS1-128 capture's metadata is named without the capture's "_lb_n3" suffix.
+  const Result r = runTaiga("info ../shared/data/ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap --json", false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["format"], "Ouster capture");
+  std::map<std::string, int> counts;
+  for (const auto& stream : j["streams"]) counts[stream["kind"].get<std::string>()] = stream["count"].get<int>();
+  EXPECT_EQ(counts["lidar"], 3);
+  EXPECT_EQ(counts["imu"], 30);
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+}
+
+TEST(Cli, InfoOnACaptureWithoutMetadataSaysWhatToGive) {
+  taiga::test::TempDir dir;
+  std::filesystem::copy_file("../shared/data/ouster/crc_test.pcap", dir.path() / "drive.pcap");
+  const Result r = runTaiga(fmt::format("info {}", (dir.path() / "drive.pcap").string()));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.output, HasSubstr("drive.pcap: an Ouster capture needs the sensor metadata JSON"));
+  EXPECT_THAT(r.output, HasSubstr("recording.ouster_metadata"));
 }
 
 TEST(Cli, InfoWarnsAboutTimesThatDoNotSpanTheScan) {
