@@ -1,0 +1,75 @@
+#include "taiga/preprocess/voxel_filter.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+#include <random>
+
+namespace taiga::preprocess {
+namespace {
+
+PointCloud cloudOf(std::vector<Eigen::Vector3d> points) {
+  PointCloud cloud;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    cloud.positions.push_back(points[i]);
+    cloud.times_s.push_back(static_cast<double>(i));
+  }
+  return cloud;
+}
+
+TEST(VoxelFilter, OnePointPerVoxelAtTheCentroid) {
+  // Two points in voxel (0,0,0), one in (-1,0,0) (negative coordinates floor down), one in (2,3,4).
+  const PointCloud cloud =
+      cloudOf({{0.1, 0.1, 0.1}, {0.3, 0.1, 0.2}, {-0.1, 0.2, 0.2}, {0.9, 1.3, 1.7}});
+  const PointCloud filtered = voxelFilter(cloud, 0.4);
+  ASSERT_EQ(filtered.size(), 3u);
+  ASSERT_TRUE(filtered.isConsistent());
+  std::vector<Eigen::Vector3d> got = filtered.positions;
+  auto has = [&](const Eigen::Vector3d& p) {
+    return std::any_of(got.begin(), got.end(),
+                       [&](const Eigen::Vector3d& q) { return (p - q).norm() < 1e-12; });
+  };
+  EXPECT_TRUE(has({0.2, 0.1, 0.15}));
+  EXPECT_TRUE(has({-0.1, 0.2, 0.2}));
+  EXPECT_TRUE(has({0.9, 1.3, 1.7}));
+}
+
+TEST(VoxelFilter, SameOutputWhateverTheInputOrderAndDropsNonFinitePoints) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> coordinate(-20.0, 20.0);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 20000; ++i)
+    points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng) * 0.1);
+  points.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
+  PointCloud cloud = cloudOf(points);
+  const PointCloud once = voxelFilter(cloud, 0.5);
+  std::shuffle(points.begin(), points.end(), rng);
+  const PointCloud shuffled = voxelFilter(cloudOf(points), 0.5);
+  ASSERT_EQ(once.size(), shuffled.size());
+  for (std::size_t i = 0; i < once.size(); ++i) {
+    ASSERT_TRUE(once.positions[i].allFinite());
+    // Centroids are sums in another order: equal up to rounding.
+    EXPECT_LT((once.positions[i] - shuffled.positions[i]).norm(), 1e-12);
+  }
+  EXPECT_LT(once.size(), cloud.size());
+}
+
+TEST(VoxelFilter, KeepsTheChannelsOfThePointNearestTheCentroid) {
+  // The centroid of the three is (0.2, 0, 0): the middle point, time 7, is nearest.
+  PointCloud cloud = cloudOf({{0.0, 0.0, 0.0}, {0.19, 0.0, 0.0}, {0.41, 0.0, 0.0}});
+  cloud.times_s = {5.0, 7.0, 9.0};
+  cloud.intensities = {1.0f, 2.0f, 3.0f};
+  const PointCloud filtered = voxelFilter(cloud, 1.0);
+  ASSERT_EQ(filtered.size(), 1u);
+  EXPECT_DOUBLE_EQ(filtered.times_s[0], 7.0);
+  EXPECT_FLOAT_EQ(filtered.intensities[0], 2.0f);
+}
+
+TEST(VoxelFilter, RejectsANonPositiveSizeAndAcceptsAnEmptyCloud) {
+  EXPECT_THROW(voxelFilter(PointCloud{}, 0.0), std::invalid_argument);
+  EXPECT_TRUE(voxelFilter(PointCloud{}, 0.4).empty());
+}
+
+}  // namespace
+}  // namespace taiga::preprocess
