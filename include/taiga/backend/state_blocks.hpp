@@ -1,0 +1,46 @@
+#pragma once
+// How the odometry states live in Ceres parameter blocks.
+//
+//   pose block   (7): [p_world (3); q_world_body as x, y, z, w (4)]      -> T_world_body
+//   motion block (9): [v_world (3); accel bias (3); gyro bias (3)]
+//
+// The pose block's tangent is [dp (3, world frame, added to p); dtheta (3, body frame, right
+// perturbation R Exp(dtheta))]. Factors write their Jacobians with respect to this tangent into
+// the first 6 columns of the 7 ambient columns (the 7th stays zero), and PoseManifold's
+// PlusJacobian is [I6; 0], so Ceres' product of the two is the tangent Jacobian itself.
+
+#include <ceres/manifold.h>
+
+#include <array>
+
+#include "taiga/imu/preintegration.hpp"
+#include "taiga/lie/se3.hpp"
+
+namespace taiga::backend {
+
+constexpr int kPoseSize = 7;
+constexpr int kPoseTangentSize = 6;
+constexpr int kMotionSize = 9;
+
+/// One odometry state in the layout above.
+struct StateBlocks {
+  std::array<double, kPoseSize> pose{0, 0, 0, 0, 0, 0, 1};
+  std::array<double, kMotionSize> motion{};
+
+  static StateBlocks from(const imu::NavState& state, const imu::ImuBias& bias);
+  imu::NavState navState() const;
+  imu::ImuBias bias() const;
+  lie::SE3 T_world_body() const;
+};
+
+class PoseManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return kPoseSize; }
+  int TangentSize() const override { return kPoseTangentSize; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
+}  // namespace taiga::backend

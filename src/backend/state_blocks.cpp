@@ -1,0 +1,73 @@
+#include "taiga/backend/state_blocks.hpp"
+
+#include <Eigen/Core>
+
+namespace taiga::backend {
+namespace {
+
+lie::SO3 rotationOf(const double* pose) {
+  return lie::SO3(Eigen::Quaterniond(pose[6], pose[3], pose[4], pose[5]));
+}
+
+void writeRotation(const lie::SO3& R, double* pose) {
+  const Eigen::Quaterniond& q = R.quaternion();
+  pose[3] = q.x();
+  pose[4] = q.y();
+  pose[5] = q.z();
+  pose[6] = q.w();
+}
+
+}  // namespace
+
+StateBlocks StateBlocks::from(const imu::NavState& state, const imu::ImuBias& bias) {
+  StateBlocks blocks;
+  Eigen::Map<Eigen::Vector3d>{blocks.pose.data()} = state.p_world;
+  writeRotation(state.R_world_body, blocks.pose.data());
+  Eigen::Map<Eigen::Vector3d>{blocks.motion.data()} = state.v_world;
+  Eigen::Map<Eigen::Vector3d>{blocks.motion.data() + 3} = bias.accel_mps2;
+  Eigen::Map<Eigen::Vector3d>{blocks.motion.data() + 6} = bias.gyro_radps;
+  return blocks;
+}
+
+imu::NavState StateBlocks::navState() const {
+  return {rotationOf(pose.data()), Eigen::Map<const Eigen::Vector3d>(pose.data()),
+          Eigen::Map<const Eigen::Vector3d>(motion.data())};
+}
+
+imu::ImuBias StateBlocks::bias() const {
+  return {Eigen::Map<const Eigen::Vector3d>(motion.data() + 3),
+          Eigen::Map<const Eigen::Vector3d>(motion.data() + 6)};
+}
+
+lie::SE3 StateBlocks::T_world_body() const {
+  return lie::SE3(rotationOf(pose.data()), Eigen::Map<const Eigen::Vector3d>(pose.data()));
+}
+
+bool PoseManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
+  for (int i = 0; i < 3; ++i) x_plus_delta[i] = x[i] + delta[i];
+  writeRotation(rotationOf(x) * lie::SO3::Exp(Eigen::Map<const Eigen::Vector3d>(delta + 3)),
+                x_plus_delta);
+  return true;
+}
+
+bool PoseManifold::PlusJacobian(const double*, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, kPoseSize, kPoseTangentSize, Eigen::RowMajor>> J(jacobian);
+  J.setZero();
+  J.topRows<6>().setIdentity();
+  return true;
+}
+
+bool PoseManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
+  for (int i = 0; i < 3; ++i) y_minus_x[i] = y[i] - x[i];
+  Eigen::Map<Eigen::Vector3d>{y_minus_x + 3} = rotationOf(y).minus(rotationOf(x));
+  return true;
+}
+
+bool PoseManifold::MinusJacobian(const double*, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, kPoseTangentSize, kPoseSize, Eigen::RowMajor>> J(jacobian);
+  J.setZero();
+  J.leftCols<6>().setIdentity();
+  return true;
+}
+
+}  // namespace taiga::backend

@@ -1,0 +1,43 @@
+#include "taiga/backend/state_prior.hpp"
+
+#include <Eigen/Cholesky>
+
+namespace taiga::backend {
+
+StatePrior::StatePrior(const StateBlocks& mean, const Matrix15& covariance)
+    : mean_(mean),
+      sqrt_information_(Eigen::LLT<Matrix15>(covariance.inverse()).matrixL().transpose()) {}
+
+bool StatePrior::Evaluate(double const* const* parameters, double* residuals,
+                          double** jacobians) const {
+  StateBlocks state;
+  std::copy(parameters[0], parameters[0] + kPoseSize, state.pose.begin());
+  std::copy(parameters[1], parameters[1] + kMotionSize, state.motion.begin());
+  const imu::NavState x = state.navState();
+  const imu::NavState x0 = mean_.navState();
+  Vector15 r;
+  r.segment<3>(0) = x.p_world - x0.p_world;
+  r.segment<3>(3) = x.R_world_body.minus(x0.R_world_body);
+  r.segment<9>(6) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(state.motion.data()) -
+                    Eigen::Map<const Eigen::Matrix<double, 9, 1>>(mean_.motion.data());
+  Eigen::Map<Vector15>{residuals} = sqrt_information_ * r;
+  if (!jacobians) return true;
+  if (jacobians[0]) {
+    Eigen::Matrix<double, 15, kPoseSize, Eigen::RowMajor> J =
+        Eigen::Matrix<double, 15, kPoseSize, Eigen::RowMajor>::Zero();
+    J.block<3, 3>(0, 0).setIdentity();
+    J.block<3, 3>(3, 3) = lie::SO3::rightJacobianInverse(r.segment<3>(3));
+    Eigen::Map<Eigen::Matrix<double, 15, kPoseSize, Eigen::RowMajor>>{jacobians[0]} =
+        sqrt_information_ * J;
+  }
+  if (jacobians[1]) {
+    Eigen::Matrix<double, 15, kMotionSize, Eigen::RowMajor> J =
+        Eigen::Matrix<double, 15, kMotionSize, Eigen::RowMajor>::Zero();
+    J.bottomRows<9>().setIdentity();
+    Eigen::Map<Eigen::Matrix<double, 15, kMotionSize, Eigen::RowMajor>>{jacobians[1]} =
+        sqrt_information_ * J;
+  }
+  return true;
+}
+
+}  // namespace taiga::backend
