@@ -1,0 +1,185 @@
+#include "taiga/backend/odometry_smoother.hpp"
+
+#include <ceres/crs_matrix.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <Eigen/Cholesky>
+#include <stdexcept>
+#include <vector>
+
+#include "taiga/backend/pose_factor.hpp"
+#include "taiga/backend/state_prior.hpp"
+
+namespace taiga::backend {
+
+struct OdometrySmoother::Node {
+  double t_s = 0.0;
+  StateBlocks blocks;
+  std::unique_ptr<ImuFactor> imu_from_previous;  ///< null for the oldest node
+  std::unique_ptr<PoseFactor> pose;              ///< null without a measurement
+  std::unique_ptr<StatePrior> prior;             ///< only on the oldest node
+};
+
+namespace {
+
+const PoseManifold kPoseManifold;
+
+ceres::Problem::Options borrowingOptions() {
+  ceres::Problem::Options options;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.enable_fast_removal = false;
+  return options;
+}
+
+void addNode(ceres::Problem& problem, StateBlocks& blocks) {
+  problem.AddParameterBlock(blocks.pose.data(), kPoseSize,
+                            const_cast<PoseManifold*>(&kPoseManifold));
+  problem.AddParameterBlock(blocks.motion.data(), kMotionSize);
+}
+
+/// Gauss-Newton information H = J^T J and gradient b = J^T r of `problem` over `blocks`, in
+/// their tangent spaces.
+void linearize(ceres::Problem& problem, const std::vector<double*>& blocks, Eigen::MatrixXd& H,
+               Eigen::VectorXd& b) {
+  ceres::Problem::EvaluateOptions options;
+  options.parameter_blocks = blocks;
+  options.num_threads = 1;
+  std::vector<double> residuals;
+  ceres::CRSMatrix jacobian;
+  problem.Evaluate(options, nullptr, &residuals, nullptr, &jacobian);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(jacobian.num_rows, jacobian.num_cols);
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k)
+      J(row, jacobian.cols[k]) = jacobian.values[k];
+  }
+  const Eigen::Map<const Eigen::VectorXd> r(residuals.data(),
+                                            static_cast<Eigen::Index>(residuals.size()));
+  H = J.transpose() * J;
+  b = J.transpose() * r;
+}
+
+/// x (+) delta in the tangent order [dp; dtheta; dv; dba; dbg].
+StateBlocks plus(const StateBlocks& x, const Eigen::Matrix<double, 15, 1>& delta) {
+  StateBlocks moved = x;
+  kPoseManifold.Plus(x.pose.data(), delta.data(), moved.pose.data());
+  for (int i = 0; i < kMotionSize; ++i) moved.motion[i] += delta[6 + i];
+  return moved;
+}
+
+}  // namespace
+
+OdometrySmoother::OdometrySmoother(OdometrySmootherOptions options) : options_(options) {
+  if (options_.window_states < 2)
+    throw std::invalid_argument("OdometrySmoother: window_states must be at least 2");
+}
+
+OdometrySmoother::~OdometrySmoother() = default;
+
+void OdometrySmoother::initialize(const StateEstimate& first) {
+  window_.clear();
+  auto node = std::make_unique<Node>();
+  node->t_s = first.t_s;
+  node->blocks = StateBlocks::from(first.state, first.bias);
+  node->prior = std::make_unique<StatePrior>(node->blocks, first.covariance);
+  window_.push_back(std::move(node));
+  latest_ = first;
+}
+
+StateEstimate OdometrySmoother::addState(double t_s, const imu::Preintegrator& preintegrated,
+                                         const std::optional<PoseMeasurement>& measurement) {
+  if (!initialized()) throw std::logic_error("OdometrySmoother::addState before initialize");
+  const Node& newest = *window_.back();
+  auto node = std::make_unique<Node>();
+  node->t_s = t_s;
+  // Initial guess: the IMU prediction from the newest state.
+  const imu::ImuBias bias = newest.blocks.bias();
+  node->blocks = StateBlocks::from(
+      preintegrated.predict(newest.blocks.navState(), bias, options_.gravity_world), bias);
+  node->imu_from_previous = std::make_unique<ImuFactor>(preintegrated, options_.gravity_world);
+  if (measurement)
+    node->pose = std::make_unique<PoseFactor>(measurement->T_world_body, measurement->covariance);
+  window_.push_back(std::move(node));
+  if (static_cast<int>(window_.size()) > options_.window_states) marginalizeOldest();
+  optimize();
+  return latest_;
+}
+
+void OdometrySmoother::optimize() {
+  ceres::Problem problem(borrowingOptions());
+  std::vector<double*> blocks;
+  for (std::size_t k = 0; k < window_.size(); ++k) {
+    Node& node = *window_[k];
+    addNode(problem, node.blocks);
+    blocks.push_back(node.blocks.pose.data());
+    blocks.push_back(node.blocks.motion.data());
+    if (node.prior)
+      problem.AddResidualBlock(node.prior.get(), nullptr, node.blocks.pose.data(),
+                               node.blocks.motion.data());
+    if (node.pose) problem.AddResidualBlock(node.pose.get(), nullptr, node.blocks.pose.data());
+    if (k > 0 && node.imu_from_previous) {
+      Node& previous = *window_[k - 1];
+      problem.AddResidualBlock(node.imu_from_previous.get(), nullptr, previous.blocks.pose.data(),
+                               previous.blocks.motion.data(), node.blocks.pose.data(),
+                               node.blocks.motion.data());
+    }
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  solver_options.max_num_iterations = options_.max_iterations;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  linearize(problem, blocks, H, b);
+  const Eigen::Index n = H.rows();
+  const Eigen::MatrixXd covariance = H.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
+  const Node& newest = *window_.back();
+  latest_.t_s = newest.t_s;
+  latest_.state = newest.blocks.navState();
+  latest_.bias = newest.blocks.bias();
+  latest_.covariance = covariance.bottomRightCorner<15, 15>();
+}
+
+void OdometrySmoother::marginalizeOldest() {
+  // The factors that touch the oldest state: its prior, its pose factor, the IMU factor to the
+  // next.
+  Node& oldest = *window_[0];
+  Node& next = *window_[1];
+  ceres::Problem problem(borrowingOptions());
+  addNode(problem, oldest.blocks);
+  addNode(problem, next.blocks);
+  if (oldest.prior)
+    problem.AddResidualBlock(oldest.prior.get(), nullptr, oldest.blocks.pose.data(),
+                             oldest.blocks.motion.data());
+  if (oldest.pose) problem.AddResidualBlock(oldest.pose.get(), nullptr, oldest.blocks.pose.data());
+  problem.AddResidualBlock(next.imu_from_previous.get(), nullptr, oldest.blocks.pose.data(),
+                           oldest.blocks.motion.data(), next.blocks.pose.data(),
+                           next.blocks.motion.data());
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  linearize(problem,
+            {oldest.blocks.pose.data(), oldest.blocks.motion.data(), next.blocks.pose.data(),
+             next.blocks.motion.data()},
+            H, b);
+  // Schur complement onto the next state: H' = H11 - H10 H00^-1 H01, b' = b1 - H10 H00^-1 b0.
+  const Eigen::LDLT<Eigen::MatrixXd> H00(H.topLeftCorner(15, 15));
+  const Matrix15 H_marginal = H.bottomRightCorner(15, 15) -
+                              H.bottomLeftCorner(15, 15) * H00.solve(H.topRightCorner(15, 15));
+  const Eigen::Matrix<double, 15, 1> b_marginal =
+      b.tail(15) - H.bottomLeftCorner(15, 15) * H00.solve(b.head(15));
+  // The quadratic 1/2 d^T H' d + b'^T d is a Gaussian with mean next (+) (-H'^-1 b').
+  const Eigen::LDLT<Matrix15> H_marginal_ldlt(H_marginal);
+  const Eigen::Matrix<double, 15, 1> shift = -H_marginal_ldlt.solve(b_marginal);
+  Matrix15 covariance = H_marginal_ldlt.solve(Matrix15::Identity());
+  covariance = 0.5 * (covariance + covariance.transpose());
+  next.prior = std::make_unique<StatePrior>(plus(next.blocks, shift), covariance);
+  next.imu_from_previous.reset();
+  window_.pop_front();
+}
+
+}  // namespace taiga::backend
