@@ -1,0 +1,43 @@
+#pragma once
+// A 3D kd-tree over a copy of the points (nanoflann, built single-threaded, so queries are
+// deterministic), and the thesis fitness score computed with it.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <limits>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "taiga/lie/se3.hpp"
+
+namespace taiga::registration {
+
+class KdTree {
+ public:
+  explicit KdTree(std::span<const Eigen::Vector3d> points);
+  ~KdTree();
+  KdTree(KdTree&&) noexcept;
+  KdTree& operator=(KdTree&&) noexcept;
+
+  std::size_t size() const;
+  const std::vector<Eigen::Vector3d>& points() const;
+  /// Up to k nearest points to `query`, closest first; returns how many were written.
+  std::size_t knn(const Eigen::Vector3d& query, std::size_t k, std::size_t* indices,
+                  double* squared_distances_m2) const;
+  /// The nearest point; false for an empty tree.
+  bool nearest(const Eigen::Vector3d& query, std::size_t& index, double& squared_distance_m2) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Thesis fitness score: mean over the source points of the squared distance (m^2) from
+/// T_target_source * p to the closest target point, counting only distances below
+/// max_distance_m. NaN when no point counts. Parallel, deterministic.
+double fitnessScore(std::span<const Eigen::Vector3d> source, const KdTree& target,
+                    const lie::SE3& T_target_source,
+                    double max_distance_m = std::numeric_limits<double>::infinity());
+
+}  // namespace taiga::registration

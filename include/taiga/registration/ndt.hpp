@@ -1,0 +1,144 @@
+#pragma once
+// Point-to-distribution NDT after Magnusson, "The Three-Dimensional Normal-Distributions
+// Transform" (PhD thesis, Orebro 2009), chapter 6, and distribution-to-distribution NDT after
+// Stoyanov et al., "Fast and accurate scan registration through minimization of the distance
+// between compact 3D NDT representations" (IJRR 2012).
+//
+// Target: voxel cells with the mean and covariance of their points; a covariance's eigenvalues
+// are clamped from below to min_eigenvalue_ratio times the largest (Magnusson 6.2). Each source
+// point x' = T x contributes the normal-plus-uniform mixture score
+//     f = d1 * exp(-d2 / 2 * (x' - mu)^T Sigma^-1 (x' - mu))
+// per neighbour cell (d1 < 0, so f is minimized; Magnusson Eq. 6.9-6.10). T = T_target_source is
+// perturbed on the right, T * Exp(tau) with tau = [rho; theta] (lie/se3.hpp); the gradient and
+// the Hessian are analytic (the point's second derivatives with respect to tau included) and
+// Newton steps with a backtracking line search minimize the score.
+//
+// D2D: the source is voxelized too and each source cell (mean m, covariance C) scores against
+// each target neighbour cell with Sigma replaced by R C R^T + Sigma_target. The derivative of
+// R C R^T with respect to theta is neglected (the combined covariance is held fixed within an
+// iteration, as GICP does), so the D2D Hessian is an approximation; Stoyanov's full derivatives
+// are not implemented.
+//
+// Parallel with TBB over fixed blocks of source points whose partial sums are added in block
+// order: the result is bit-identical for any number of threads.
+
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+#include "taiga/lie/se3.hpp"
+#include "taiga/registration/result.hpp"
+#include "taiga/registration/voxel_index.hpp"
+#include "taiga/registration/voxel_statistics.hpp"
+
+namespace taiga::registration {
+
+/// Which target cells a source point is scored against (Magnusson 6.2.1; ndt_omp's names).
+enum class NeighbourSearch {
+  kDirect1,  ///< the cell that contains the point
+  kDirect7,  ///< that cell and its six face neighbours
+};
+
+struct NdtConfig {
+  double resolution_m = 1.0;  ///< cell edge, m
+  /// Optional coarser resolutions (m, each larger than resolution_m) run first, coarsest first.
+  std::vector<double> coarse_resolutions_m;
+  NeighbourSearch search = NeighbourSearch::kDirect7;
+  double outlier_ratio = 0.55;          ///< weight of the uniform part of the mixture, (0, 1)
+  std::size_t min_points_per_cell = 6;  ///< fewer points: the cell is not used
+  double min_eigenvalue_ratio = 0.01;   ///< eigenvalue clamp, relative to the largest, (0, 1]
+  int max_iterations = 35;              ///< per resolution
+  double step_epsilon_m = 1e-3;         ///< converged when the translation step is below this...
+  double step_epsilon_rad = 1e-4;       ///< ...and the rotation step below this
+  double max_step_m = 0.5;              ///< a longer Newton translation step is scaled down
+  /// Planarity check of the source: degenerate when the smallest eigenvalue of the source
+  /// covariance is below this fraction of the largest.
+  double planar_eigenvalue_ratio = 1e-6;
+  /// Throws std::invalid_argument naming the field when a value is out of range.
+  void validate() const;
+};
+
+/// One NDT cell of the target.
+struct NdtCell {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();          ///< regularized, m^2
+  Eigen::Matrix3d inverse_covariance = Eigen::Matrix3d::Identity();  ///< of the regularized one
+  std::size_t count = 0;
+};
+
+/// Target cells with a hash index; built once, read concurrently.
+class NdtTarget {
+ public:
+  NdtTarget() = default;
+  /// From the statistics of a (local) map; cells with fewer than min_points_per_cell points or a
+  /// zero covariance are dropped.
+  NdtTarget(const VoxelStatistics& stats, std::size_t min_points_per_cell = 6,
+            double min_eigenvalue_ratio = 0.01);
+  static NdtTarget fromPoints(std::span<const Eigen::Vector3d> points, double resolution_m,
+                              std::size_t min_points_per_cell = 6,
+                              double min_eigenvalue_ratio = 0.01);
+
+  double resolution_m() const { return resolution_m_; }
+  const std::vector<NdtCell>& cells() const { return cells_; }
+  bool empty() const { return cells_.empty(); }
+  /// Writes the cells near `p` into `out` (up to 7) and returns how many.
+  int neighbours(const Eigen::Vector3d& p, NeighbourSearch search, const NdtCell** out) const;
+
+ private:
+  double resolution_m_ = 1.0;
+  double inverse_resolution_ = 1.0;
+  std::vector<NdtCell> cells_;
+  std::vector<VoxelKey> keys_;
+  VoxelIndex index_;
+};
+
+/// The mixture constants d1, d2 of Magnusson Eq. 6.8 for a cell size and outlier ratio.
+struct NdtConstants {
+  double d1 = 0.0;
+  double d2 = 0.0;
+};
+NdtConstants ndtConstants(double resolution_m, double outlier_ratio);
+
+/// Score, gradient and Hessian of the NDT cost at T * Exp(tau) for tau = 0.
+struct NdtDerivatives {
+  double score = 0.0;
+  lie::Vector6 gradient = lie::Vector6::Zero();
+  lie::Matrix6 hessian = lie::Matrix6::Zero();
+  std::size_t num_inliers = 0;
+};
+
+/// P2D cost at T_target_source; without the Hessian when `with_hessian` is false.
+NdtDerivatives ndtDerivatives(std::span<const Eigen::Vector3d> source, const NdtTarget& target,
+                              const lie::SE3& T_target_source, const NdtConfig& config,
+                              bool with_hessian = true);
+
+/// Source cells for D2D-NDT (mean and regularized covariance).
+struct D2dSource {
+  std::vector<Eigen::Vector3d> means;
+  std::vector<Eigen::Matrix3d> covariances;
+};
+D2dSource makeD2dSource(std::span<const Eigen::Vector3d> source, const NdtConfig& config,
+                        double resolution_m);
+
+/// D2D cost at T_target_source (see the header comment for the approximation in the Hessian).
+NdtDerivatives d2dDerivatives(const D2dSource& source, const NdtTarget& target,
+                              const lie::SE3& T_target_source, const NdtConfig& config,
+                              bool with_hessian = true);
+
+/// P2D-NDT against a prebuilt target (one resolution: the target's; coarse_resolutions_m unused).
+RegistrationResult alignNdt(std::span<const Eigen::Vector3d> source, const NdtTarget& target,
+                            const lie::SE3& guess_T_target_source, const NdtConfig& config);
+/// P2D-NDT against target points, coarse to fine when config.coarse_resolutions_m is set.
+RegistrationResult alignNdt(std::span<const Eigen::Vector3d> source,
+                            std::span<const Eigen::Vector3d> target,
+                            const lie::SE3& guess_T_target_source, const NdtConfig& config);
+
+/// D2D-NDT against a prebuilt target; the source is voxelized at the target's resolution.
+RegistrationResult alignD2dNdt(std::span<const Eigen::Vector3d> source, const NdtTarget& target,
+                               const lie::SE3& guess_T_target_source, const NdtConfig& config);
+/// D2D-NDT against target points, coarse to fine when config.coarse_resolutions_m is set.
+RegistrationResult alignD2dNdt(std::span<const Eigen::Vector3d> source,
+                               std::span<const Eigen::Vector3d> target,
+                               const lie::SE3& guess_T_target_source, const NdtConfig& config);
+
+}  // namespace taiga::registration

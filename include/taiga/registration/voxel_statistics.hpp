@@ -1,0 +1,77 @@
+#pragma once
+// Incremental voxel statistics: per cell the count, the sum of points and the sum of their outer
+// products, so that a keyframe's points can be added to and removed from a local map without
+// rebuilding it. The NDT target (ndt.hpp) and voxel downsampling are built from these sums.
+//
+// Sums are kept as integers: each point is quantized to kQuantum_m (10 um) relative to the centre
+// of its cell. Adding and then removing the same points therefore restores the statistics exactly,
+// bit for bit, and the result does not depend on the order in which points were added. The
+// quantization changes a mean by at most 5 um. Limits: at cells of R m a cell holds up to
+// 3.7e9 / R^2 points before the 64-bit square sums could overflow.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include "taiga/registration/voxel_index.hpp"
+
+namespace taiga::registration {
+
+/// Moments of one cell.
+struct CellMoments {
+  VoxelKey key = kInvalidVoxel;
+  std::size_t count = 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();        ///< m, in the frame of the points
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< m^2, unbiased (n - 1); 0 if n < 2
+};
+
+class VoxelStatistics {
+ public:
+  static constexpr double kQuantum_m = 1e-5;
+
+  /// Cells of `resolution_m` (> 0) metres; throws std::invalid_argument otherwise.
+  explicit VoxelStatistics(double resolution_m);
+
+  double resolution_m() const { return resolution_m_; }
+  /// Adds points (non-finite points and points beyond the voxel range are skipped and counted).
+  void add(std::span<const Eigen::Vector3d> points);
+  /// Removes points that were added before (the same coordinates). Removing a point that is not
+  /// in the statistics throws std::logic_error, leaving the statistics partially updated.
+  void remove(std::span<const Eigen::Vector3d> points);
+  void clear() { cells_.clear(); }
+
+  std::size_t numCells() const { return cells_.size(); }
+  std::size_t numPoints() const;
+  std::size_t numSkipped() const { return skipped_; }
+  /// Moments of every cell with at least `min_points` points, sorted by voxel key (so the order
+  /// is deterministic).
+  std::vector<CellMoments> moments(std::size_t min_points = 1) const;
+  /// Cell means of every occupied cell, in key order: a voxel-grid downsampling.
+  std::vector<Eigen::Vector3d> means() const;
+
+  /// Exact equality of the sums (the same cells with the same integer sums).
+  bool operator==(const VoxelStatistics& other) const;
+
+ private:
+  struct Sums {
+    std::int64_t count = 0;
+    std::int64_t s[3] = {0, 0, 0};
+    std::int64_t ss[6] = {0, 0, 0, 0, 0, 0};  ///< xx xy xz yy yz zz
+    bool operator==(const Sums& o) const;
+  };
+  void update(const Eigen::Vector3d& p, int sign);
+  CellMoments momentsOf(VoxelKey key, const Sums& sums) const;
+
+  double resolution_m_;
+  double inverse_resolution_;
+  std::size_t skipped_ = 0;
+  std::unordered_map<VoxelKey, Sums> cells_;
+};
+
+/// Voxel-grid downsampling: one point (the mean) per occupied cell of `leaf_m`, in key order.
+std::vector<Eigen::Vector3d> voxelDownsample(std::span<const Eigen::Vector3d> points,
+                                             double leaf_m);
+
+}  // namespace taiga::registration

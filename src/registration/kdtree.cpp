@@ -1,0 +1,80 @@
+#include "taiga/registration/kdtree.hpp"
+
+#include <nanoflann.hpp>
+
+#include "block_reduce.hpp"
+
+namespace taiga::registration {
+namespace {
+
+struct Adaptor {
+  const std::vector<Eigen::Vector3d>* points;
+  std::size_t kdtree_get_point_count() const { return points->size(); }
+  double kdtree_get_pt(std::size_t i, std::size_t dim) const { return (*points)[i][dim]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
+};
+
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Adaptor>,
+                                                 Adaptor, 3, std::size_t>;
+
+}  // namespace
+
+struct KdTree::Impl {
+  std::vector<Eigen::Vector3d> points;
+  Adaptor adaptor{&points};
+  Tree tree;
+  explicit Impl(std::span<const Eigen::Vector3d> p)
+      : points(p.begin(), p.end()),
+        tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {}
+};
+
+KdTree::KdTree(std::span<const Eigen::Vector3d> points) : impl_(std::make_unique<Impl>(points)) {}
+KdTree::~KdTree() = default;
+KdTree::KdTree(KdTree&&) noexcept = default;
+KdTree& KdTree::operator=(KdTree&&) noexcept = default;
+
+std::size_t KdTree::size() const { return impl_->points.size(); }
+const std::vector<Eigen::Vector3d>& KdTree::points() const { return impl_->points; }
+
+std::size_t KdTree::knn(const Eigen::Vector3d& query, std::size_t k, std::size_t* indices,
+                        double* squared_distances_m2) const {
+  if (impl_->points.empty() || k == 0) return 0;
+  return impl_->tree.knnSearch(query.data(), k, indices, squared_distances_m2);
+}
+
+bool KdTree::nearest(const Eigen::Vector3d& query, std::size_t& index,
+                     double& squared_distance_m2) const {
+  return knn(query, 1, &index, &squared_distance_m2) == 1;
+}
+
+double fitnessScore(std::span<const Eigen::Vector3d> source, const KdTree& target,
+                    const lie::SE3& T_target_source, double max_distance_m) {
+  struct Partial {
+    double sum = 0.0;
+    std::size_t count = 0;
+  };
+  const Eigen::Matrix3d R = T_target_source.rotation().matrix();
+  const Eigen::Vector3d t = T_target_source.translation();
+  const double max_sq = max_distance_m * max_distance_m;
+  const Partial total = detail::reduceInBlocks<Partial>(
+      source.size(),
+      [&](std::size_t i, Partial& out) {
+        std::size_t index;
+        double sq;
+        if (target.nearest(R * source[i] + t, index, sq) && sq <= max_sq) {
+          out.sum += sq;
+          ++out.count;
+        }
+      },
+      [](Partial& a, const Partial& b) {
+        a.sum += b.sum;
+        a.count += b.count;
+      });
+  if (total.count == 0) return std::numeric_limits<double>::quiet_NaN();
+  return total.sum / static_cast<double>(total.count);
+}
+
+}  // namespace taiga::registration

@@ -1,0 +1,94 @@
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "taiga/registration/ndt.hpp"
+
+namespace taiga::registration {
+
+void NdtConfig::validate() const {
+  auto fail = [](const std::string& field, const std::string& expected, double value) {
+    throw std::invalid_argument("NdtConfig." + field + ": expected " + expected + ", got " +
+                                std::to_string(value));
+  };
+  if (!(resolution_m > 0.0)) fail("resolution_m", "> 0 m", resolution_m);
+  for (double r : coarse_resolutions_m) {
+    if (!(r > resolution_m)) fail("coarse_resolutions_m", "values > resolution_m", r);
+  }
+  if (!(outlier_ratio > 0.0 && outlier_ratio < 1.0)) fail("outlier_ratio", "(0, 1)", outlier_ratio);
+  if (min_points_per_cell < 3) {
+    fail("min_points_per_cell", ">= 3", static_cast<double>(min_points_per_cell));
+  }
+  if (!(min_eigenvalue_ratio > 0.0 && min_eigenvalue_ratio <= 1.0)) {
+    fail("min_eigenvalue_ratio", "(0, 1]", min_eigenvalue_ratio);
+  }
+  if (max_iterations < 1) fail("max_iterations", ">= 1", max_iterations);
+  if (!(step_epsilon_m > 0.0)) fail("step_epsilon_m", "> 0 m", step_epsilon_m);
+  if (!(step_epsilon_rad > 0.0)) fail("step_epsilon_rad", "> 0 rad", step_epsilon_rad);
+  if (!(max_step_m > 0.0)) fail("max_step_m", "> 0 m", max_step_m);
+}
+
+NdtConstants ndtConstants(double resolution_m, double outlier_ratio) {
+  // Magnusson Eq. 6.8 (as in PCL and ndt_omp): c1, c2 make the mixture integrate to one over a
+  // cell; d3 removes the constant so the score of a far-away point is zero.
+  const double c1 = 10.0 * (1.0 - outlier_ratio);
+  const double c2 = outlier_ratio / std::pow(resolution_m, 3);
+  const double d3 = -std::log(c2);
+  NdtConstants k;
+  k.d1 = -std::log(c1 + c2) - d3;
+  k.d2 = -2.0 * std::log((-std::log(c1 * std::exp(-0.5) + c2) - d3) / k.d1);
+  return k;
+}
+
+NdtTarget::NdtTarget(const VoxelStatistics& stats, std::size_t min_points_per_cell,
+                     double min_eigenvalue_ratio)
+    : resolution_m_(stats.resolution_m()), inverse_resolution_(1.0 / stats.resolution_m()) {
+  for (const CellMoments& m : stats.moments(min_points_per_cell)) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(m.covariance);
+    Eigen::Vector3d lambda = solver.eigenvalues();
+    const double lambda_max = lambda.maxCoeff();
+    if (!(lambda_max > 0.0)) continue;  // all points equal (after quantization)
+    lambda = lambda.cwiseMax(min_eigenvalue_ratio * lambda_max);
+    const Eigen::Matrix3d& V = solver.eigenvectors();
+    NdtCell cell;
+    cell.mean = m.mean;
+    cell.count = m.count;
+    cell.covariance = V * lambda.asDiagonal() * V.transpose();
+    cell.inverse_covariance = V * lambda.cwiseInverse().asDiagonal() * V.transpose();
+    cells_.push_back(cell);
+    keys_.push_back(m.key);
+  }
+  index_ = VoxelIndex(keys_);
+}
+
+NdtTarget NdtTarget::fromPoints(std::span<const Eigen::Vector3d> points, double resolution_m,
+                                std::size_t min_points_per_cell, double min_eigenvalue_ratio) {
+  VoxelStatistics stats(resolution_m);
+  stats.add(points);
+  return NdtTarget(stats, min_points_per_cell, min_eigenvalue_ratio);
+}
+
+int NdtTarget::neighbours(const Eigen::Vector3d& p, NeighbourSearch search,
+                          const NdtCell** out) const {
+  const VoxelKey key = voxelOf(p, inverse_resolution_);
+  if (key == kInvalidVoxel) return 0;
+  int n = 0;
+  if (const std::int32_t i = index_.find(key); i >= 0) out[n++] = &cells_[i];
+  if (search == NeighbourSearch::kDirect7) {
+    // Packed axes: x in bits 42.., y in 21.., z in 0..; a neighbour differs by +-1 on one axis.
+    // Keys are away from the axis limits by construction of voxelOf (|i| < 1e6 < 2^20 - 1).
+    constexpr std::int64_t kSteps[6] = {std::int64_t{1} << 42,
+                                        -(std::int64_t{1} << 42),
+                                        std::int64_t{1} << 21,
+                                        -(std::int64_t{1} << 21),
+                                        1,
+                                        -1};
+    for (std::int64_t step : kSteps) {
+      if (const std::int32_t i = index_.find(key + step); i >= 0) out[n++] = &cells_[i];
+    }
+  }
+  return n;
+}
+
+}  // namespace taiga::registration

@@ -1,0 +1,47 @@
+#include "taiga/registration/registration.hpp"
+
+#include "taiga/registration/kdtree.hpp"
+
+namespace taiga::registration {
+
+std::optional<Method> methodFromName(const std::string& name) {
+  if (name == "ndt") return Method::kNdt;
+  if (name == "d2d") return Method::kD2dNdt;
+  if (name == "gicp") return Method::kGicp;
+  return std::nullopt;
+}
+
+std::string methodName(Method method) {
+  switch (method) {
+    case Method::kNdt:
+      return "ndt";
+    case Method::kD2dNdt:
+      return "d2d";
+    case Method::kGicp:
+      return "gicp";
+  }
+  return "?";
+}
+
+RegistrationResult registerClouds(std::span<const Eigen::Vector3d> source,
+                                  std::span<const Eigen::Vector3d> target, const lie::SE3& guess,
+                                  const RegistrationConfig& config) {
+  RegistrationResult result;
+  switch (config.method) {
+    case Method::kNdt:
+      result = alignNdt(source, target, guess, config.ndt);
+      break;
+    case Method::kD2dNdt:
+      result = alignD2dNdt(source, target, guess, config.ndt);
+      break;
+    case Method::kGicp:
+      result = alignGicp(source, target, guess, config.gicp);
+      break;
+  }
+  if (config.compute_fitness && !source.empty() && !target.empty()) {
+    result.fitness_m2 = fitnessScore(source, KdTree(target), result.T_target_source);
+  }
+  return result;
+}
+
+}  // namespace taiga::registration

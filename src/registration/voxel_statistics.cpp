@@ -1,0 +1,130 @@
+#include "taiga/registration/voxel_statistics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace taiga::registration {
+
+VoxelIndex::VoxelIndex(const std::vector<VoxelKey>& keys) {
+  std::uint64_t capacity = 16;
+  while (capacity < 2 * keys.size()) capacity *= 2;
+  keys_.assign(capacity, kInvalidVoxel);
+  values_.assign(capacity, -1);
+  mask_ = capacity - 1;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    std::uint64_t slot = hash(keys[i]) & mask_;
+    while (keys_[slot] != kInvalidVoxel) slot = (slot + 1) & mask_;
+    keys_[slot] = keys[i];
+    values_[slot] = static_cast<std::int32_t>(i);
+  }
+}
+
+bool VoxelStatistics::Sums::operator==(const Sums& o) const {
+  return count == o.count && std::equal(s, s + 3, o.s) && std::equal(ss, ss + 6, o.ss);
+}
+
+VoxelStatistics::VoxelStatistics(double resolution_m)
+    : resolution_m_(resolution_m), inverse_resolution_(1.0 / resolution_m) {
+  if (!(resolution_m > 0.0) || !std::isfinite(resolution_m)) {
+    throw std::invalid_argument("VoxelStatistics: resolution_m must be positive, got " +
+                                std::to_string(resolution_m));
+  }
+}
+
+void VoxelStatistics::update(const Eigen::Vector3d& p, int sign) {
+  const VoxelKey key = voxelOf(p, inverse_resolution_);
+  if (key == kInvalidVoxel) {
+    if (sign > 0) ++skipped_;
+    return;
+  }
+  const Eigen::Matrix<std::int64_t, 3, 1> index = unpackVoxel(key);
+  std::int64_t q[3];
+  for (int a = 0; a < 3; ++a) {
+    const double centre = (static_cast<double>(index[a]) + 0.5) * resolution_m_;
+    q[a] = std::llround((p[a] - centre) / kQuantum_m);
+  }
+  auto it = cells_.find(key);
+  if (sign < 0 && it == cells_.end()) {
+    throw std::logic_error("VoxelStatistics::remove: a point that was never added");
+  }
+  Sums& sums = sign > 0 ? cells_[key] : it->second;
+  sums.count += sign;
+  for (int a = 0; a < 3; ++a) sums.s[a] += sign * q[a];
+  sums.ss[0] += sign * q[0] * q[0];
+  sums.ss[1] += sign * q[0] * q[1];
+  sums.ss[2] += sign * q[0] * q[2];
+  sums.ss[3] += sign * q[1] * q[1];
+  sums.ss[4] += sign * q[1] * q[2];
+  sums.ss[5] += sign * q[2] * q[2];
+  if (sums.count == 0) cells_.erase(key);
+}
+
+void VoxelStatistics::add(std::span<const Eigen::Vector3d> points) {
+  for (const auto& p : points) update(p, +1);
+}
+
+void VoxelStatistics::remove(std::span<const Eigen::Vector3d> points) {
+  for (const auto& p : points) update(p, -1);
+}
+
+std::size_t VoxelStatistics::numPoints() const {
+  std::size_t n = 0;
+  for (const auto& [key, sums] : cells_) n += static_cast<std::size_t>(sums.count);
+  return n;
+}
+
+CellMoments VoxelStatistics::momentsOf(VoxelKey key, const Sums& sums) const {
+  CellMoments m;
+  m.key = key;
+  m.count = static_cast<std::size_t>(sums.count);
+  const Eigen::Matrix<std::int64_t, 3, 1> index = unpackVoxel(key);
+  const double n = static_cast<double>(sums.count);
+  const Eigen::Vector3d s(static_cast<double>(sums.s[0]), static_cast<double>(sums.s[1]),
+                          static_cast<double>(sums.s[2]));
+  const Eigen::Vector3d centre = (index.cast<double>().array() + 0.5) * resolution_m_;
+  m.mean = centre + s * (kQuantum_m / n);
+  if (sums.count >= 2) {
+    Eigen::Matrix3d ss;
+    ss << static_cast<double>(sums.ss[0]), static_cast<double>(sums.ss[1]),
+        static_cast<double>(sums.ss[2]), static_cast<double>(sums.ss[1]),
+        static_cast<double>(sums.ss[3]), static_cast<double>(sums.ss[4]),
+        static_cast<double>(sums.ss[2]), static_cast<double>(sums.ss[4]),
+        static_cast<double>(sums.ss[5]);
+    m.covariance = (ss - s * s.transpose() / n) * (kQuantum_m * kQuantum_m / (n - 1.0));
+  }
+  return m;
+}
+
+std::vector<CellMoments> VoxelStatistics::moments(std::size_t min_points) const {
+  std::vector<VoxelKey> keys;
+  keys.reserve(cells_.size());
+  for (const auto& [key, sums] : cells_) {
+    if (static_cast<std::size_t>(sums.count) >= min_points) keys.push_back(key);
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<CellMoments> out;
+  out.reserve(keys.size());
+  for (VoxelKey key : keys) out.push_back(momentsOf(key, cells_.at(key)));
+  return out;
+}
+
+std::vector<Eigen::Vector3d> VoxelStatistics::means() const {
+  std::vector<Eigen::Vector3d> out;
+  for (const CellMoments& m : moments(1)) out.push_back(m.mean);
+  return out;
+}
+
+bool VoxelStatistics::operator==(const VoxelStatistics& other) const {
+  return resolution_m_ == other.resolution_m_ && cells_ == other.cells_;
+}
+
+std::vector<Eigen::Vector3d> voxelDownsample(std::span<const Eigen::Vector3d> points,
+                                             double leaf_m) {
+  VoxelStatistics stats(leaf_m);
+  stats.add(points);
+  return stats.means();
+}
+
+}  // namespace taiga::registration

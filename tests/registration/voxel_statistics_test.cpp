@@ -1,0 +1,102 @@
+// Incremental voxel statistics: exact add/remove, order independence, moments against a direct
+// computation, and the NDT target built from a map that had a keyframe added and removed.
+#include "taiga/registration/voxel_statistics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "taiga/registration/ndt.hpp"
+
+namespace taiga::registration {
+namespace {
+
+std::vector<Eigen::Vector3d> randomPoints(std::size_t n, unsigned seed, double extent_m) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-extent_m, extent_m);
+  std::vector<Eigen::Vector3d> out(n);
+  for (auto& p : out) p = {u(rng), u(rng), 0.2 * u(rng)};
+  return out;
+}
+
+TEST(VoxelStatistics, AddThenRemoveEqualsNeverAdded) {
+  const auto a = randomPoints(20000, 1, 10.0);
+  const auto b = randomPoints(5000, 2, 12.0);
+  VoxelStatistics only_a(1.0);
+  only_a.add(a);
+  VoxelStatistics map(1.0);
+  map.add(a);
+  map.add(b);
+  EXPECT_FALSE(map == only_a);
+  map.remove(b);
+  EXPECT_TRUE(map == only_a);
+  EXPECT_EQ(map.numPoints(), a.size());
+  EXPECT_EQ(map.numCells(), only_a.numCells());
+
+  // The NDT target built from the map is the same, cell for cell and bit for bit.
+  const NdtTarget from_map(map);
+  const NdtTarget from_a(only_a);
+  ASSERT_EQ(from_map.cells().size(), from_a.cells().size());
+  ASSERT_GT(from_a.cells().size(), 100u);
+  for (std::size_t i = 0; i < from_a.cells().size(); ++i) {
+    EXPECT_EQ(from_map.cells()[i].mean, from_a.cells()[i].mean);
+    EXPECT_EQ(from_map.cells()[i].inverse_covariance, from_a.cells()[i].inverse_covariance);
+  }
+}
+
+TEST(VoxelStatistics, OrderOfAddingDoesNotMatter) {
+  const auto a = randomPoints(3000, 3, 5.0);
+  const auto b = randomPoints(3000, 4, 5.0);
+  VoxelStatistics ab(0.5), ba(0.5);
+  ab.add(a);
+  ab.add(b);
+  ba.add(b);
+  ba.add(a);
+  EXPECT_TRUE(ab == ba);
+}
+
+TEST(VoxelStatistics, MomentsMatchADirectComputation) {
+  // Points in one 2 m cell, away from the origin as map coordinates are.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 0.2);
+  std::vector<Eigen::Vector3d> points;
+  const Eigen::Vector3d centre(101.0, -47.0, 3.0);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3d p = centre + Eigen::Vector3d(n(rng), 0.5 * n(rng), 0.1 * n(rng));
+    if (((p - centre).array().abs() < 0.99).all()) points.push_back(p);
+  }
+  VoxelStatistics stats(2.0);
+  stats.add(points);
+  ASSERT_EQ(stats.numCells(), 1u);
+  const CellMoments m = stats.moments().front();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) cov += (p - mean) * (p - mean).transpose();
+  cov /= static_cast<double>(points.size() - 1);
+  EXPECT_EQ(m.count, points.size());
+  EXPECT_LT((m.mean - mean).norm(), 1e-6);  // quantization is 10 um per point, averaged
+  EXPECT_LT((m.covariance - cov).norm(), 1e-7);
+  EXPECT_GT(cov.norm(), 1e-2);
+}
+
+TEST(VoxelStatistics, RemovingAPointThatWasNeverAddedThrows) {
+  VoxelStatistics stats(1.0);
+  const std::vector<Eigen::Vector3d> p = {{0.5, 0.5, 0.5}};
+  EXPECT_THROW(stats.remove(p), std::logic_error);
+  EXPECT_THROW(VoxelStatistics(0.0), std::invalid_argument);
+}
+
+TEST(VoxelStatistics, DownsampleKeepsOnePointPerCell) {
+  const std::vector<Eigen::Vector3d> p = {
+      {0.1, 0.1, 0.1}, {0.3, 0.3, 0.3}, {1.5, 0.1, 0.1}, {std::nan(""), 0.0, 0.0}};
+  const auto down = voxelDownsample(p, 1.0);
+  ASSERT_EQ(down.size(), 2u);
+  EXPECT_NEAR(down[0].x(), 0.2, 1e-5);
+  EXPECT_NEAR(down[1].x(), 1.5, 1e-5);
+}
+
+}  // namespace
+}  // namespace taiga::registration
