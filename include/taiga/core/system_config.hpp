@@ -3,6 +3,7 @@
 // modules that own them land.
 
 #include "taiga/core/config.hpp"
+#include "taiga/core/odometry_config.hpp"
 #include "taiga/core/recording_config.hpp"
 #include "taiga/core/rig_config.hpp"
 
@@ -11,10 +12,13 @@ namespace taiga {
 struct SystemConfig final : ConfigSection {
   RigConfig rig;
   RecordingConfig recording;
+  OdometryConfig odometry;
 
   void visit(ConfigVisitor& v) override {
     v.section("rig", rig, "sensor rig: extrinsics, clock offset and units");
     v.section("recording", recording, "which streams to read and how to interpret them");
+    v.section("odometry", odometry,
+              "lidar-inertial odometry: preprocessing, registration, keyframes, IMU noise");
   }
 };
 

@@ -1,0 +1,53 @@
+#pragma once
+// Configuration of the lidar-inertial odometry (pipeline/): preprocessing, registration to the
+// local map, the lidar factor's covariance, keyframes and the IMU noise model.
+
+#include <string>
+
+#include "taiga/core/config.hpp"
+
+namespace taiga {
+
+struct ImuNoiseConfig final : ConfigSection {
+  double accel_noise_density = 2.0e-3;     ///< m/s^2/sqrt(Hz)
+  double gyro_noise_density = 1.7e-4;      ///< rad/s/sqrt(Hz)
+  double accel_bias_random_walk = 3.0e-4;  ///< m/s^3/sqrt(Hz)
+  double gyro_bias_random_walk = 2.0e-5;   ///< rad/s^2/sqrt(Hz)
+  double gravity_mps2 = 9.81;
+
+  void visit(ConfigVisitor& v) override;
+  void validate() const override;
+};
+
+struct OdometryConfig final : ConfigSection {
+  // Preprocessing (thesis 3.1.1).
+  double min_range_m = 1.0;  ///< returns closer than this (the operator, the rig) are dropped
+  double max_range_m = 80.0;
+  double voxel_size_m = 0.4;  ///< voxel filter of the registration source
+  // Registration to the local map.
+  std::string method = "ndt";  ///< ndt | d2d | gicp
+  double ndt_resolution_m = 1.0;
+  double local_map_voxel_m = 0.2;  ///< keyframe points enter the local map at this spacing
+  int local_map_keyframes = 20;    ///< keyframes the local map holds
+  // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
+  double lidar_sigma = 0.01;            ///< sigma_sm: m and rad, at good fitness
+  double fitness_threshold_m2 = 0.3;    ///< tau_fs
+  double fitness_sigma_exponent = 2.0;  ///< theta_smsc
+  // Rejection of registrations that disagree with the IMU prediction or did not work.
+  double max_fitness_m2 = 2.0;
+  double max_jump_m = 0.5;
+  double max_jump_deg = 5.0;
+  double degenerate_condition =
+      1e5;  ///< Hessian condition number above which the factor is inflated
+  // Keyframes (thesis Eq. 37: travelled distance weighted with rotation).
+  double keyframe_distance_m = 1.0;
+  double keyframe_rotation_weight_m_per_rad = 2.0;
+  // Odometry graph.
+  int window_states = 5;
+  ImuNoiseConfig imu;
+
+  void visit(ConfigVisitor& v) override;
+  void validate() const override;
+};
+
+}  // namespace taiga

@@ -1,0 +1,76 @@
+#include "taiga/core/odometry_config.hpp"
+
+#include <array>
+
+namespace taiga {
+
+void ImuNoiseConfig::visit(ConfigVisitor& v) {
+  v.field("accel_noise_density", accel_noise_density, "m/s^2/sqrt(Hz), accelerometer white noise");
+  v.field("gyro_noise_density", gyro_noise_density, "rad/s/sqrt(Hz), gyroscope white noise");
+  v.field("accel_bias_random_walk", accel_bias_random_walk,
+          "m/s^3/sqrt(Hz), accelerometer bias random walk");
+  v.field("gyro_bias_random_walk", gyro_bias_random_walk,
+          "rad/s^2/sqrt(Hz), gyroscope bias random walk");
+  v.field("gravity_mps2", gravity_mps2, "m/s^2, local gravity magnitude");
+}
+
+void ImuNoiseConfig::validate() const {
+  requirePositive("accel_noise_density", accel_noise_density, "m/s^2/sqrt(Hz)");
+  requirePositive("gyro_noise_density", gyro_noise_density, "rad/s/sqrt(Hz)");
+  requirePositive("accel_bias_random_walk", accel_bias_random_walk, "m/s^3/sqrt(Hz)");
+  requirePositive("gyro_bias_random_walk", gyro_bias_random_walk, "rad/s^2/sqrt(Hz)");
+  requireInRange("gravity_mps2", gravity_mps2, 9.7, 9.9, "m/s^2");
+}
+
+void OdometryConfig::visit(ConfigVisitor& v) {
+  v.field("min_range_m", min_range_m, "m, returns closer to the lidar are dropped (operator, rig)");
+  v.field("max_range_m", max_range_m, "m, returns farther from the lidar are dropped");
+  v.field("voxel_size_m", voxel_size_m, "m, voxel filter of the scan registered to the local map");
+  static constexpr std::array<std::string_view, 3> kMethods{"ndt", "d2d", "gicp"};
+  v.choice("method", method, kMethods,
+           "scan-to-map registration: ndt, d2d (distribution-to-distribution) or gicp");
+  v.field("ndt_resolution_m", ndt_resolution_m, "m, NDT cell size of the local map");
+  v.field("local_map_voxel_m", local_map_voxel_m, "m, spacing of keyframe points in the local map");
+  v.field("local_map_keyframes", local_map_keyframes, "keyframes held in the local map");
+  v.field("lidar_sigma", lidar_sigma,
+          "m and rad, sigma of the lidar factor at good fitness (thesis sigma_sm)");
+  v.field("fitness_threshold_m2", fitness_threshold_m2,
+          "m^2, fitness above which the sigma grows (thesis tau_fs)");
+  v.field("fitness_sigma_exponent", fitness_sigma_exponent,
+          "exponent of that growth (thesis theta_smsc)");
+  v.field("max_fitness_m2", max_fitness_m2, "m^2, registrations with a worse fitness are not used");
+  v.field("max_jump_m", max_jump_m,
+          "m, registrations further from the IMU prediction are not used");
+  v.field("max_jump_deg", max_jump_deg,
+          "deg, registrations rotated further from the IMU prediction are not used");
+  v.field("degenerate_condition", degenerate_condition,
+          "Hessian condition number above which the lidar factor is inflated");
+  v.field("keyframe_distance_m", keyframe_distance_m,
+          "m, weighted travelled distance between keyframes");
+  v.field("keyframe_rotation_weight_m_per_rad", keyframe_rotation_weight_m_per_rad,
+          "m/rad, weight of rotation in the travelled distance");
+  v.field("window_states", window_states, "states in the odometry graph's fixed-lag window (>= 2)");
+  v.section("imu", imu, "IMU noise model");
+}
+
+void OdometryConfig::validate() const {
+  requireNonNegative("min_range_m", min_range_m, "m");
+  requireInRange("max_range_m", max_range_m, min_range_m + 0.1, 1000.0, "m");
+  requireInRange("voxel_size_m", voxel_size_m, 0.01, 5.0, "m");
+  requireInRange("ndt_resolution_m", ndt_resolution_m, 0.1, 10.0, "m");
+  requireInRange("local_map_voxel_m", local_map_voxel_m, 0.01, 5.0, "m");
+  requireInRange("local_map_keyframes", local_map_keyframes, 1, 1000, "keyframes");
+  requirePositive("lidar_sigma", lidar_sigma, "m");
+  requirePositive("fitness_threshold_m2", fitness_threshold_m2, "m^2");
+  requireNonNegative("fitness_sigma_exponent", fitness_sigma_exponent, "");
+  requirePositive("max_fitness_m2", max_fitness_m2, "m^2");
+  requirePositive("max_jump_m", max_jump_m, "m");
+  requirePositive("max_jump_deg", max_jump_deg, "deg");
+  requireInRange("degenerate_condition", degenerate_condition, 10.0, 1e12, "");
+  requirePositive("keyframe_distance_m", keyframe_distance_m, "m");
+  requireNonNegative("keyframe_rotation_weight_m_per_rad", keyframe_rotation_weight_m_per_rad,
+                     "m/rad");
+  requireInRange("window_states", window_states, 2, 50, "states");
+}
+
+}  // namespace taiga
