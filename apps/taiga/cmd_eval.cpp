@@ -1,15 +1,81 @@
-// taiga eval: trajectory accuracy metrics.
+// taiga eval: trajectory accuracy metrics (docs/evaluation.md).
+#include <fmt/format.h>
+
+#include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "command.hpp"
+#include "taiga/core/errors.hpp"
+#include "taiga/eval/plot.hpp"
+#include "taiga/eval/report.hpp"
+#include "taiga/io/trajectory_io.hpp"
 
 namespace taiga::app {
 namespace {
 struct EvalOptions {
   std::string estimate, reference;
   std::string align = "se3";
+  int rpe_delta = 1;
+  std::optional<double> rpe_delta_m;
+  bool rotation = false;
+  double t_max_diff_s = 0.01;
+  double t_offset_s = 0.0;
+  std::string timing;
+  double scan_period_s = 0.1;
+  std::string plots;
+  bool distance = false;
+  double distance_bin_m = 0.1;
   bool json = false;
+  bool markdown = false;
 };
+
+int runEval(const EvalOptions& options) {
+  eval::EvalReport report;
+  report.est_file = options.estimate;
+  report.ref_file = options.reference;
+  report.show_distance = options.distance;
+  eval::EvalOptions& o = report.options;
+  o.association = {options.t_max_diff_s, options.t_offset_s};
+  o.alignment = eval::parseAlignment(options.align);
+  o.rotation = options.rotation;
+  o.rpe_delta_frames = static_cast<std::size_t>(options.rpe_delta);
+  o.rpe_delta_m = options.rpe_delta_m;
+  o.distance_bin_m = options.distance_bin_m;
+
+  const Trajectory est = io::readTrajectory(options.estimate);
+  const Trajectory ref = io::readTrajectory(options.reference);
+  try {
+    report.result = eval::evaluate(est, ref, o);
+  } catch (const InputError& e) {
+    throw InputError(
+        fmt::format("{} against {}: {}", options.estimate, options.reference, e.what()));
+  }
+  if (!options.timing.empty()) {
+    report.timing_file = options.timing;
+    report.timing_table = eval::readTimingCsv(options.timing);
+    report.timing = eval::computeTimingStatistics(*report.timing_table, options.scan_period_s);
+  }
+
+  if (options.json)
+    fmt::print("{}", eval::formatEvalJson(report));
+  else if (options.markdown)
+    fmt::print("{}", eval::formatEvalMarkdown(report));
+  else
+    fmt::print("{}", eval::formatEvalText(report));
+  std::fflush(stdout);
+
+  if (!options.plots.empty()) {
+    const eval::PlotOutcome plots =
+        eval::makePlots(eval::formatEvalPlotData(report), options.plots, "eval_plot_data.json");
+    if (!plots.ok) {
+      fmt::print(stderr, "taiga eval: {}\n", plots.message);
+      return kExitFailure;
+    }
+    for (const auto& file : plots.files) fmt::print(stderr, "wrote {}\n", file.string());
+  }
+  return kExitOk;
+}
 }  // namespace
 
 Command addEvalCommand(CLI::App& tool) {
@@ -19,11 +85,47 @@ Command addEvalCommand(CLI::App& tool) {
   parser->add_option("--est", options->estimate, "Estimated trajectory (TUM or KITTI)")->required();
   parser->add_option("--ref", options->reference, "Reference trajectory (TUM or KITTI)")
       ->required();
-  parser->add_option("--align", options->align, "Alignment before comparing")
+  parser
+      ->add_option("--align", options->align,
+                   "Alignment before comparing (evo: -a, -as, --align_origin)")
       ->check(CLI::IsMember({"se3", "sim3", "origin", "none"}))
       ->capture_default_str();
+  parser
+      ->add_option("--rpe-delta", options->rpe_delta,
+                   "RPE delta in frames (evo --delta N --delta_unit f)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  parser
+      ->add_option("--rpe-delta-m", options->rpe_delta_m,
+                   "Also RPE over this many metres of path (evo --delta D --delta_unit m)")
+      ->check(CLI::PositiveNumber);
+  parser->add_flag("--rotation", options->rotation,
+                   "Also the rotation errors, in degrees (evo -r angle_deg)");
+  parser
+      ->add_option("--t-max-diff", options->t_max_diff_s,
+                   "Largest time difference of associated poses, s (evo --t_max_diff)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  parser
+      ->add_option("--t-offset", options->t_offset_s,
+                   "Added to the estimate's times before associating, s (evo --t_offset)")
+      ->capture_default_str();
+  parser->add_option("--timing", options->timing,
+                     "timing.csv of the run: processing time statistics");
+  parser
+      ->add_option("--scan-period-s", options->scan_period_s,
+                   "Sensor period for the timing statistics, s")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  parser->add_option("--plots", options->plots, "Write PNG plots into this directory");
+  parser->add_flag("--distance", options->distance,
+                   "Show the distance distribution between the two trajectories (unaligned)");
+  parser->add_option("--distance-bin-m", options->distance_bin_m, "Histogram bin width, m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   parser->add_flag("--json", options->json, "Print JSON instead of text");
-  return {parser, notImplemented("eval", "trajectory evaluation is issue 8"), options};
+  parser->add_flag("--markdown", options->markdown, "Print Markdown tables instead of text");
+  return {parser, [options] { return runEval(*options); }, options};
 }
 
 }  // namespace taiga::app

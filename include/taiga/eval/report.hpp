@@ -1,0 +1,32 @@
+#pragma once
+// The evaluation as people and scripts read it: plain text, a Markdown table, JSON, and the
+// series the plotting script draws.
+
+#include <optional>
+#include <string>
+
+#include "taiga/eval/evaluate.hpp"
+#include "taiga/eval/timing.hpp"
+
+namespace taiga::eval {
+
+struct EvalReport {
+  std::string est_file, ref_file;
+  EvalOptions options;
+  EvalResult result;
+  std::optional<std::string> timing_file;
+  std::optional<TimingTable> timing_table;
+  std::optional<TimingStatistics> timing;
+  bool show_distance = false;  ///< include the distance distribution in text and Markdown
+};
+
+/// Statistics with 6 decimals, as evo prints them.
+std::string formatEvalText(const EvalReport& report);
+std::string formatEvalMarkdown(const EvalReport& report);
+/// One JSON object with every number at full precision (NaN and infinity as null).
+std::string formatEvalJson(const EvalReport& report);
+/// The series for scripts/plot_eval.py ("kind": "eval"): positions of the reference and the
+/// aligned estimate, APE per pose over time and along the reference path, timing per scan.
+std::string formatEvalPlotData(const EvalReport& report);
+
+}  // namespace taiga::eval

@@ -1,0 +1,151 @@
+#!/usr/bin/python3
+"""Plots for `taiga eval --plots DIR` and `taiga compare --plots DIR`.
+
+Usage: /usr/bin/python3 plot_eval.py DATA.json OUT_DIR LISTING
+
+DATA.json is written by taiga (src/eval/report_json.cpp, src/eval/compare.cpp). The PNGs go to
+OUT_DIR and their paths, one per line, to LISTING. Exit codes: 0 done, 2 bad arguments or data,
+3 matplotlib missing (taiga turns that into an install hint).
+"""
+import json
+import os
+import sys
+
+try:
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only, no display needed
+    import matplotlib.pyplot as plt
+except ImportError as error:
+    sys.stderr.write(f"plot_eval.py: cannot import matplotlib ({error})\n")
+    sys.exit(3)
+
+DPI = 120
+
+
+def save(fig, out_dir, name, written):
+    path = os.path.join(out_dir, name)
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    written.append(path)
+
+
+def xy(series):
+    return [p[0] for p in series["xyz"]], [p[1] for p in series["xyz"]]
+
+
+def top_view(ax, reference, estimates, ref_label):
+    rx, ry = xy(reference)
+    ax.plot(rx, ry, color="black", linestyle="--", linewidth=1.2, label=f"reference ({ref_label})")
+    for label, series in estimates:
+        ex, ey = xy(series)
+        ax.plot(ex, ey, linewidth=1.2, label=label)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+
+
+def relative_times(series):
+    t = series["t_s"]
+    return [v - t[0] for v in t] if t else []
+
+
+def plot_timing(timing, out_dir, written, title):
+    t0 = timing["t_s"][0] if timing["t_s"] else 0.0
+    t = [v - t0 for v in timing["t_s"]]
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    stages = timing["stages"]
+    if stages:
+        ax1.stackplot(t, [s["ms"] for s in stages], labels=[s["name"] for s in stages], alpha=0.7)
+    ax1.plot(t, timing["total_ms"], color="black", linewidth=0.8, label="total_ms")
+    ax1.axhline(timing["period_ms"], color="red", linestyle="--", linewidth=1,
+                label=f"sensor period {timing['period_ms']:g} ms")
+    ax1.set_xlabel("time since the first scan (s)")
+    ax1.set_ylabel("processing time per scan (ms)")
+    ax1.set_title(title)
+    ax1.grid(True, alpha=0.3)
+    ax1.legend(fontsize="small", loc="upper left")
+    ax2.hist(timing["total_ms"], bins=50, color="tab:blue", edgecolor="white")
+    ax2.axvline(timing["period_ms"], color="red", linestyle="--", linewidth=1)
+    ax2.set_xlabel("total processing time per scan (ms)")
+    ax2.set_ylabel("scans")
+    ax2.set_title("distribution")
+    ax2.grid(True, alpha=0.3)
+    save(fig, out_dir, "timing.png", written)
+
+
+def plot_eval(data, out_dir, written):
+    ref, est = data["reference"], data["estimate"]
+    fig, ax = plt.subplots(figsize=(8, 7))
+    top_view(ax, ref, [(f"estimate ({data['est_label']}, {data['alignment']} aligned)", est)],
+             data["ref_label"])
+    ax.set_title("trajectory, top view")
+    save(fig, out_dir, "trajectory_top.png", written)
+
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 7))
+    ape = data["ape_m"]
+    ax1.plot(relative_times(ref), ape, linewidth=1)
+    ax1.set_xlabel("time since the first associated pose (s)")
+    ax1.set_ylabel("APE translation (m)")
+    ax1.set_title(f"absolute position error ({data['alignment']} alignment)")
+    ax1.grid(True, alpha=0.3)
+    ax2.plot(ref["path_m"], ape, linewidth=1, color="tab:orange")
+    ax2.set_xlabel("distance along the reference path (m)")
+    ax2.set_ylabel("APE translation (m)")
+    ax2.grid(True, alpha=0.3)
+    save(fig, out_dir, "ape.png", written)
+
+    if "timing" in data:
+        plot_timing(data["timing"], out_dir, written, "processing time per scan")
+
+
+def plot_compare(data, out_dir, written):
+    runs = data["runs"]
+    fig, ax = plt.subplots(figsize=(8, 7))
+    top_view(ax, data["reference"], [(run["name"], run["estimate"]) for run in runs],
+             data["ref_label"])
+    ax.set_title(f"runs, top view ({data['alignment']} aligned)")
+    save(fig, out_dir, "compare_top.png", written)
+
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    for run in runs:
+        ax.plot(relative_times(run["estimate"]), run["ape_m"], linewidth=1, label=run["name"])
+    ax.set_xlabel("time since the first associated pose (s)")
+    ax.set_ylabel("APE translation (m)")
+    ax.set_title("absolute position error per run")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    save(fig, out_dir, "compare_ape.png", written)
+
+
+def main(argv):
+    if len(argv) != 4:
+        sys.stderr.write(__doc__)
+        return 2
+    data_path, out_dir, listing = argv[1], argv[2], argv[3]
+    try:
+        with open(data_path, encoding="utf-8") as f:
+            data = json.load(f)
+    except (OSError, ValueError) as error:
+        sys.stderr.write(f"plot_eval.py: {data_path}: {error}\n")
+        return 2
+    os.makedirs(out_dir, exist_ok=True)
+    written = []
+    kind = data.get("kind")
+    if kind == "eval":
+        plot_eval(data, out_dir, written)
+    elif kind == "compare":
+        plot_compare(data, out_dir, written)
+    else:
+        sys.stderr.write(f"plot_eval.py: {data_path}: unknown kind {kind!r}\n")
+        return 2
+    with open(listing, "w", encoding="utf-8") as f:
+        f.write("".join(path + "\n" for path in written))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,79 @@
+// JSON renderings of an evaluation: the report for scripts and the series for the plots.
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "json_helpers.hpp"
+#include "taiga/eval/report.hpp"
+
+namespace taiga::eval {
+namespace {
+
+using nlohmann::json;
+
+json rpeJson(const RpeResult& rpe) {
+  return {{"delta", rpe.options.delta},
+          {"delta_unit", rpe.options.unit == DeltaUnit::kFrames ? "frames" : "m"},
+          {"pairs", rpe.pairs.size()},
+          {"translation_m", detail::statisticsJson(rpe.translation_m)},
+          {"rotation_deg", detail::statisticsJson(rpe.rotation_deg)}};
+}
+
+}  // namespace
+
+std::string formatEvalJson(const EvalReport& report) {
+  const EvalResult& r = report.result;
+  json j;
+  j["estimate"] = {{"file", report.est_file}, {"poses", r.est_count}};
+  j["reference"] = {{"file", report.ref_file}, {"poses", r.ref_count}};
+  j["association"] = {{"pairs", r.pairs.size()},
+                      {"t_max_diff_s", report.options.association.t_max_diff_s},
+                      {"t_offset_s", report.options.association.t_offset_s}};
+  const Eigen::Quaterniond q = r.transform.T_ref_est.rotation().quaternion();
+  j["alignment"] = {{"method", std::string(alignmentName(r.alignment))},
+                    {"translation_m", detail::vectorJson(r.transform.T_ref_est.translation())},
+                    {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}},
+                    {"scale", r.transform.scale}};
+  json ape = {{"translation_m", detail::statisticsJson(r.ape.translation_m)},
+              {"rmse_per_axis_m", detail::vectorJson(r.ape.rmse_per_axis_m)}};
+  if (r.ape.rotation_deg) ape["rotation_deg"] = detail::statisticsJson(*r.ape.rotation_deg);
+  j["ape"] = ape;
+  j["rpe"] = json::array({rpeJson(r.rpe_frames)});
+  if (r.rpe_metres) j["rpe"].push_back(rpeJson(*r.rpe_metres));
+  if (r.kitti)
+    j["kitti"] = {{"segments", r.kitti->segments.size()},
+                  {"translation_error_percent", r.kitti->translation_error_percent},
+                  {"rotation_error_deg_per_100m", r.kitti->rotation_error_deg_per_100m}};
+  else
+    j["kitti"] = nullptr;
+  j["drift"] = {{"drift_m", r.drift.drift_m},
+                {"drift_vector_m", detail::vectorJson(r.drift.drift_vector_m)},
+                {"reference_path_length_m", r.drift.reference_path_length_m},
+                {"drift_percent", r.drift.drift_percent}};
+  const DistanceDistribution& d = r.distance;
+  j["distance"] = {{"mean_m", d.mean_m},
+                   {"std_m", d.std_m},
+                   {"min_m", d.min_m},
+                   {"max_m", d.max_m},
+                   {"bin_width_m", d.bin_width_m},
+                   {"first_bin_start_m", d.first_bin_start_m},
+                   {"counts", d.counts}};
+  if (report.timing) j["timing"] = detail::timingJson(*report.timing, report.timing_file);
+  return detail::dump(j);
+}
+
+std::string formatEvalPlotData(const EvalReport& report) {
+  const EvalResult& r = report.result;
+  json j;
+  j["kind"] = "eval";
+  j["est_label"] = report.est_file;
+  j["ref_label"] = report.ref_file;
+  j["alignment"] = std::string(alignmentName(r.alignment));
+  j["reference"] = detail::seriesJson(r.pairs.ref);
+  j["estimate"] = detail::seriesJson(r.est_aligned);
+  j["ape_m"] = r.ape.translation_error_m;
+  if (report.timing_table && report.timing)
+    j["timing"] = detail::timingSeriesJson(*report.timing_table, *report.timing);
+  return detail::dump(j);
+}
+
+}  // namespace taiga::eval

@@ -1,0 +1,153 @@
+// Text and Markdown renderings of an evaluation.
+#include <fmt/format.h>
+
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "taiga/eval/report.hpp"
+
+namespace taiga::eval {
+namespace {
+
+struct StatsRow {
+  std::string name;
+  ErrorStatistics stats;
+};
+
+struct ValueRow {
+  std::string name;
+  std::string value;
+};
+
+std::string deltaText(const RpeOptions& o) {
+  if (o.unit == DeltaUnit::kFrames)
+    return fmt::format("delta {} frame{}", o.delta, o.delta == 1.0 ? "" : "s");
+  return fmt::format("delta {} m", o.delta);
+}
+
+std::vector<StatsRow> statsRows(const EvalReport& report) {
+  const EvalResult& r = report.result;
+  std::vector<StatsRow> rows{{"APE translation (m)", r.ape.translation_m}};
+  if (r.ape.rotation_deg) rows.push_back({"APE rotation (deg)", *r.ape.rotation_deg});
+  const auto add_rpe = [&](const RpeResult& rpe) {
+    const std::string d = deltaText(rpe.options);
+    rows.push_back({fmt::format("RPE translation (m), {}", d), rpe.translation_m});
+    if (report.options.rotation)
+      rows.push_back({fmt::format("RPE rotation (deg), {}", d), rpe.rotation_deg});
+  };
+  add_rpe(r.rpe_frames);
+  if (r.rpe_metres) add_rpe(*r.rpe_metres);
+  return rows;
+}
+
+std::string transformText(const EvalResult& r) {
+  const Eigen::Vector3d& t = r.transform.T_ref_est.translation();
+  return fmt::format("rotation {:.6f} deg, translation [{:.6f}, {:.6f}, {:.6f}] m, scale {:.6f}",
+                     r.transform.T_ref_est.rotation().angle() * 180.0 / std::numbers::pi, t.x(),
+                     t.y(), t.z(), r.transform.scale);
+}
+
+std::vector<ValueRow> valueRows(const EvalReport& report) {
+  const EvalResult& r = report.result;
+  std::vector<ValueRow> rows;
+  const Eigen::Vector3d& axis = r.ape.rmse_per_axis_m;
+  rows.push_back({"APE translation RMSE per axis (m)",
+                  fmt::format("x {:.6f}  y {:.6f}  z {:.6f}", axis.x(), axis.y(), axis.z())});
+  if (r.kitti) {
+    rows.push_back({"KITTI translational error (%)",
+                    fmt::format("{:.4f} ({} segments of 100..800 m)",
+                                r.kitti->translation_error_percent, r.kitti->segments.size())});
+    rows.push_back({"KITTI rotational error (deg/100 m)",
+                    fmt::format("{:.4f}", r.kitti->rotation_error_deg_per_100m)});
+  } else {
+    rows.push_back({"KITTI errors", "none: the reference path is not longer than 100 m"});
+  }
+  rows.push_back({"End-point drift (m)",
+                  fmt::format("{:.6f} (dx {:.6f}, dy {:.6f}, dz {:.6f}; first poses aligned)",
+                              r.drift.drift_m, r.drift.drift_vector_m.x(),
+                              r.drift.drift_vector_m.y(), r.drift.drift_vector_m.z())});
+  rows.push_back({"End-point drift (% of path)",
+                  fmt::format("{:.4f} (reference path {:.3f} m)", r.drift.drift_percent,
+                              r.drift.reference_path_length_m)});
+  if (report.show_distance) {
+    const DistanceDistribution& d = r.distance;
+    rows.push_back({"Distance est-ref, unaligned (m)",
+                    fmt::format("mean {:.6f}  std {:.6f}  min {:.6f}  max {:.6f}", d.mean_m,
+                                d.std_m, d.min_m, d.max_m)});
+    for (std::size_t k = 0; k < d.counts.size(); ++k) {
+      const double lo = d.first_bin_start_m + static_cast<double>(k) * d.bin_width_m;
+      rows.push_back({fmt::format("  [{:.2f}, {:.2f}) m", lo, lo + d.bin_width_m),
+                      fmt::format("{}", d.counts[k])});
+    }
+  }
+  if (report.timing) {
+    const TimingStatistics& t = *report.timing;
+    for (const StageTiming& s : t.stages)
+      rows.push_back({fmt::format("Time {} (ms)", s.name),
+                      fmt::format("mean {:.3f}  median {:.3f}  p95 {:.3f}  max {:.3f}", s.mean_ms,
+                                  s.median_ms, s.p95_ms, s.max_ms)});
+    rows.push_back({fmt::format("Scans over the {} ms period", t.scan_period_s * 1000.0),
+                    fmt::format("{} of {} ({:.2f} %)", t.scans_over_period, t.scan_count,
+                                t.share_over_period * 100.0)});
+    rows.push_back({"Real-time factor",
+                    fmt::format("{:.3f} ({:.3f} s of data in {:.3f} s)", t.real_time_factor,
+                                t.recording_duration_s, t.processing_s)});
+  }
+  return rows;
+}
+
+std::string headerText(const EvalReport& report) {
+  const EvalResult& r = report.result;
+  std::string out;
+  out += fmt::format("estimate    {} ({} poses)\n", report.est_file, r.est_count);
+  out += fmt::format("reference   {} ({} poses)\n", report.ref_file, r.ref_count);
+  out += fmt::format("associated  {} pairs (|dt| <= {} s, estimate time offset {} s)\n",
+                     r.pairs.size(), report.options.association.t_max_diff_s,
+                     report.options.association.t_offset_s);
+  out += fmt::format("alignment   {}: {}\n", alignmentName(r.alignment), transformText(r));
+  if (report.timing_file)
+    out += fmt::format("timing      {} ({} scans)\n", *report.timing_file,
+                       report.timing ? report.timing->scan_count : 0);
+  return out;
+}
+
+}  // namespace
+
+std::string formatEvalText(const EvalReport& report) {
+  std::string out = headerText(report) + "\n";
+  out += fmt::format("{:<40} {:>8} {:>12} {:>12} {:>12} {:>12} {:>12} {:>12}\n", "", "count",
+                     "rmse", "mean", "median", "std", "min", "max");
+  for (const StatsRow& row : statsRows(report)) {
+    const ErrorStatistics& s = row.stats;
+    out += fmt::format("{:<40} {:>8} {:>12.6f} {:>12.6f} {:>12.6f} {:>12.6f} {:>12.6f} {:>12.6f}\n",
+                       row.name, s.count, s.rmse, s.mean, s.median, s.std, s.min, s.max);
+  }
+  out += "\n";
+  for (const ValueRow& row : valueRows(report))
+    out += fmt::format("{:<40} {}\n", row.name, row.value);
+  return out;
+}
+
+std::string formatEvalMarkdown(const EvalReport& report) {
+  std::string out;
+  const EvalResult& r = report.result;
+  out += fmt::format(
+      "Estimate `{}` ({} poses) against reference `{}` ({} poses): {} associated "
+      "pairs, alignment {} ({}).\n\n",
+      report.est_file, r.est_count, report.ref_file, r.ref_count, r.pairs.size(),
+      alignmentName(r.alignment), transformText(r));
+  out += "| metric | count | rmse | mean | median | std | min | max |\n";
+  out += "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const StatsRow& row : statsRows(report)) {
+    const ErrorStatistics& s = row.stats;
+    out += fmt::format("| {} | {} | {:.6f} | {:.6f} | {:.6f} | {:.6f} | {:.6f} | {:.6f} |\n",
+                       row.name, s.count, s.rmse, s.mean, s.median, s.std, s.min, s.max);
+  }
+  out += "\n| metric | value |\n|---|---|\n";
+  for (const ValueRow& row : valueRows(report))
+    out += fmt::format("| {} | {} |\n", row.name, row.value);
+  return out;
+}
+
+}  // namespace taiga::eval
