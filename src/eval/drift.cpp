@@ -45,6 +45,12 @@ DistanceDistribution computeDistanceDistribution(const std::vector<StampedPose>&
   result.max_m = s.max;
   const auto first_bin = static_cast<long long>(std::floor(s.min / bin_width_m));
   const auto last_bin = static_cast<long long>(std::floor(s.max / bin_width_m));
+  constexpr long long kMaxBins = 100000;
+  if (last_bin - first_bin + 1 > kMaxBins)
+    throw InputError(fmt::format(
+        "the distances span {} m to {} m: more than {} bins of {} m; choose a wider bin "
+        "(--distance-bin-m)",
+        s.min, s.max, kMaxBins, bin_width_m));
   result.first_bin_start_m = static_cast<double>(first_bin) * bin_width_m;
   result.counts.assign(static_cast<std::size_t>(last_bin - first_bin + 1), 0);
   for (const double d : result.distances_m)

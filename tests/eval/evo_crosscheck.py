@@ -4,7 +4,8 @@
 The numpy code below follows evo's source (evo/core/sync.py associate_trajectories,
 geometry.umeyama_alignment, trajectory.align / align_origin, metrics.APE / RPE,
 filters.filter_pairs_by_index / filter_pairs_by_path) line by line, with numpy's SVD instead of
-Eigen's. It is not evo itself (evo is not packaged for Debian); it checks that taiga's C++ computes
+Eigen's, and the KITTI devkit's calcSequenceErrors and the end-point drift likewise. It is not
+evo itself (evo is not packaged for Debian); it checks that taiga's C++ computes
 the same numbers as those definitions on a trajectory pair with a clock offset, time jitter,
 missing poses, a scale error, random-walk drift and a global transform.
 
@@ -127,6 +128,7 @@ def evo_numbers(directory, align, offset, delta_m):
     tr, pr = load(os.path.join(directory, "ref.tum"))
     te, pe = load(os.path.join(directory, "est.tum"))
     pr, pe = associate(tr, pr, te, pe, 0.01, offset)
+    pe_raw = pe
     if align in ("se3", "sim3"):
         r, t, c = umeyama(np.array([p[:3, 3] for p in pe]).T, np.array([p[:3, 3] for p in pr]).T,
                           align == "sim3")
@@ -149,6 +151,24 @@ def evo_numbers(directory, align, offset, delta_m):
         E = [inv(inv(pr[i]) @ pr[j]) @ (inv(pe[i]) @ pe[j]) for i, j in pairs]
         return (stats([np.linalg.norm(e[:3, 3]) for e in E]), stats([angle_deg(e[:3, :3]) for e in E]))
 
+    # KITTI devkit calcSequenceErrors (double instead of float) and end-point drift.
+    dist = [0.0]
+    for a, b in zip(pr, pr[1:]):
+        dist.append(dist[-1] + np.linalg.norm(b[:3, 3] - a[:3, 3]))
+    t_err, r_err = [], []
+    for first in range(0, len(pr), 10):
+        for length in range(100, 900, 100):
+            last = next((i for i in range(first, len(pr)) if dist[i] > dist[first] + length), -1)
+            if last == -1:
+                continue
+            E = inv(inv(pe[first]) @ pe[last]) @ (inv(pr[first]) @ pr[last])
+            t_err.append(np.linalg.norm(E[:3, 3]) / length)
+            r_err.append(np.arccos(max(min(0.5 * (np.trace(E[:3, :3]) - 1), 1.0), -1.0)) / length)
+    out["kitti"] = {"translation_error_percent": np.mean(t_err) * 100,
+                    "rotation_error_deg_per_100m": np.mean(r_err) * 180 / np.pi * 100,
+                    "segments": len(t_err)}
+    out["drift"] = {"drift_m": np.linalg.norm((pr[0] @ inv(pe_raw[0]) @ pe_raw[-1])[:3, 3] - pr[-1][:3, 3]),
+                    "reference_path_length_m": dist[-1]}
     ids = np.arange(0, len(pe), 1)
     out["rpe_f_t"], out["rpe_f_r"] = rpe(list(zip(ids, ids[1:])))
     ids, previous, path = [], pe[0], 0.0
@@ -172,7 +192,8 @@ def taiga_numbers(executable, directory, align, offset, delta_m):
     return {"pairs": j["association"]["pairs"],
             "ape_t": j["ape"]["translation_m"], "ape_r": j["ape"]["rotation_deg"],
             "rpe_f_t": j["rpe"][0]["translation_m"], "rpe_f_r": j["rpe"][0]["rotation_deg"],
-            "rpe_m_t": j["rpe"][1]["translation_m"], "rpe_m_r": j["rpe"][1]["rotation_deg"]}
+            "rpe_m_t": j["rpe"][1]["translation_m"], "rpe_m_r": j["rpe"][1]["rotation_deg"],
+            "kitti": j["kitti"], "drift": j["drift"]}
 
 
 def main():
@@ -191,14 +212,16 @@ def main():
                     continue
                 # Angles: arccos here vs the rotation's log in taiga; 1e-7 deg covers arccos'
                 # conditioning near 0. Translations agree to 1e-9 relative.
-                tolerance_abs = 1e-7 if key.endswith("_r") else 1e-12
+                tolerance_abs = 1e-7 if key.endswith("_r") or key == "kitti" else 1e-12
                 for stat, value in expected[key].items():
                     got = actual[key][stat]
                     if not np.isclose(got, value, rtol=1e-9, atol=tolerance_abs):
                         print(f"{align} {key} {stat}: taiga {got!r}, evo definition {value!r}")
                         failures += 1
             print(f"{align}: {expected['pairs']} pairs, APE rmse {expected['ape_t']['rmse']:.6f} m, "
-                  f"RPE(10 m) pairs {expected['rpe_m_t']['count']}: "
+                  f"RPE(10 m) pairs {expected['rpe_m_t']['count']}, "
+                  f"KITTI {expected['kitti']['translation_error_percent']:.4f} % over "
+                  f"{expected['kitti']['segments']} segments: "
                   + ("agree" if failures == 0 else "DISAGREE"))
     return 1 if failures else 0
 

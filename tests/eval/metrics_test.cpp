@@ -198,6 +198,8 @@ TEST(Distance, HistogramInTenthsOfAMetreAndItsSpread) {
   const DistanceDistribution far = computeDistanceDistribution(a, b, 0.1);
   EXPECT_NEAR(far.first_bin_start_m, 1.0, 1e-12);
   EXPECT_THROW(computeDistanceDistribution(a, b, 0.0), InputError);
+  EXPECT_THAT(taiga::test::messageOf<InputError>([&] { computeDistanceDistribution(a, b, 1e-7); }),
+              ::testing::HasSubstr("choose a wider bin"));
 }
 
 TEST(Evaluate, NoMatchingStampsIsAnInputErrorNamingTheTolerance) {
