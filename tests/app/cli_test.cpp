@@ -171,9 +171,9 @@ TEST(Cli, ExportWritesOneScanOrAll) {
 }
 
 TEST(Cli, UnbuiltSubcommandsSaySoAndFail) {
-  const Result r = runTaiga("simulate --out /tmp/unused");
+  const Result r = runTaiga("georef --traj t.tum --gnss g.csv --method pf6 --out /tmp/unused");
   EXPECT_EQ(r.exit_code, 69);
-  EXPECT_THAT(r.output, HasSubstr("taiga simulate: not implemented yet"));
+  EXPECT_THAT(r.output, HasSubstr("taiga georef: not implemented yet"));
 }
 
 TEST(Cli, ConfigPrintsDefaultsAndNamesBadKeys) {

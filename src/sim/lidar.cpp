@@ -1,0 +1,225 @@
+#include "taiga/sim/lidar.hpp"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "taiga/core/errors.hpp"
+#include "taiga/core/log.hpp"
+#include "taiga/io/ouster/sensor_info.hpp"
+#include "taiga/sim/random.hpp"
+
+namespace taiga::sim {
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+constexpr int kMaxSubRays = 8;
+/// Reflectivity of the target that reaches max_range_m at normal incidence.
+constexpr double kReferenceReflectivity = 0.8;
+
+/// One pixel's outcome before compaction.
+struct Pixel {
+  bool valid = false;
+  Eigen::Vector3f p_sensor = Eigen::Vector3f::Zero();
+  float intensity = 0.0f;
+};
+
+struct SubHit {
+  double range_m;
+  double weight;
+  double reflectivity_eff;  ///< reflectivity * cos(incidence)
+};
+}  // namespace
+
+LidarGeometry loadLidarGeometry(const LidarParams& params) {
+  if (params.beams < 1)
+    throw InputError(fmt::format("lidar.beams: expected at least 1, found {}", params.beams));
+  if (params.columns < 16)
+    throw InputError(fmt::format("lidar.columns: expected at least 16, found {}", params.columns));
+  LidarGeometry g;
+  if (!params.metadata_json.empty() && std::filesystem::exists(params.metadata_json)) {
+    const io::ouster::SensorInfo info = io::ouster::readSensorInfo(params.metadata_json);
+    const auto n = static_cast<int>(info.beam_altitude_angles_deg.size());
+    if (params.beams > n) {
+      throw InputError(fmt::format("{}: has {} beams, {} were asked for", params.metadata_json, n,
+                                   params.beams));
+    }
+    for (int i = 0; i < params.beams; ++i) {
+      // Evenly subsample: a 128-beam table gives a 64- or 32-beam head of the same field of view.
+      const int row = params.beams == 1
+                          ? n / 2
+                          : static_cast<int>(std::lround(i * (n - 1.0) / (params.beams - 1.0)));
+      g.beam_altitude_deg.push_back(info.beam_altitude_angles_deg[row]);
+      g.beam_azimuth_deg.push_back(
+          info.beam_azimuth_angles_deg.empty() ? 0.0 : info.beam_azimuth_angles_deg[row]);
+    }
+    g.lidar_origin_to_beam_origin_m = info.lidar_origin_to_beam_origin_mm / 1000.0;
+    g.beam_origin_z_m = info.T_lidar_beam.translation().z();
+    g.T_sensor_lidar = info.T_sensor_lidar;
+    g.T_sensor_imu = info.T_sensor_imu;
+    g.source = params.metadata_json;
+    return g;
+  }
+  logger().warn(
+      "{}: not found; the simulated lidar uses {} beams spread uniformly over {} deg",
+      params.metadata_json.empty() ? std::string("(no metadata file)") : params.metadata_json,
+      params.beams, params.fallback_vertical_fov_deg);
+  for (int i = 0; i < params.beams; ++i) {
+    const double f = params.beams == 1 ? 0.5 : static_cast<double>(i) / (params.beams - 1);
+    g.beam_altitude_deg.push_back(params.fallback_vertical_fov_deg * (0.5 - f));
+    g.beam_azimuth_deg.push_back(0.0);
+  }
+  // OS0 frames as in its metadata: lidar frame turned 180 deg about z, 36.18 mm above the sensor
+  // frame's origin; the IMU offset by (6.253, -11.775, 7.645) mm.
+  g.T_sensor_lidar = lie::SE3(lie::SO3::fromAxisAngle(Eigen::Vector3d::UnitZ(), kPi),
+                              Eigen::Vector3d(0, 0, 0.03618));
+  g.T_sensor_imu = lie::SE3(lie::SO3(), Eigen::Vector3d(0.006253, -0.011775, 0.007645));
+  g.lidar_origin_to_beam_origin_m = 0.015806;
+  g.source = "uniform fallback";
+  return g;
+}
+
+LidarSimulator::LidarSimulator(LidarParams params, LidarGeometry geometry, std::uint64_t seed)
+    : params_(std::move(params)), geometry_(std::move(geometry)), seed_(streamSeed(seed, "lidar")) {
+  params_.sub_rays = std::clamp(params_.sub_rays, 1, kMaxSubRays);
+}
+
+io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& motion,
+                                      std::uint64_t index, double t_start_s,
+                                      double time_offset_s) const {
+  const int rows = this->rows(), cols = params_.columns;
+  const double dt_column = scanPeriod_s() / cols;
+  const lie::SE3 T_body_sensor = T_body_lidar();
+  std::vector<Pixel> pixels(static_cast<std::size_t>(rows) * cols);
+
+  // Sub-ray pattern: the centre and a ring at 3/4 of the half divergence, weights of a Gaussian
+  // footprint.
+  const int k_rays = params_.sub_rays;
+  const double ring_rad = 0.75 * 0.5 * params_.beam_divergence_deg * kDeg;
+  const double center_weight = k_rays == 1 ? 1.0 : 0.4;
+  const double ring_weight = k_rays == 1 ? 0.0 : 0.6 / (k_rays - 1);
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>&
+                                                                  range) {
+    std::array<SubHit, kMaxSubRays> hits{};
+    for (int col = range.begin(); col != range.end(); ++col) {
+      const double t = t_start_s + col * dt_column;
+      const lie::SE3 T_world_lidar =
+          motion.at(t).T_world_body * T_body_sensor * geometry_.T_sensor_lidar;
+      const Eigen::Matrix3d R = T_world_lidar.rotation().matrix();
+      const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
+      const Eigen::Vector3d origin_lidar(
+          geometry_.lidar_origin_to_beam_origin_m * std::cos(theta_e),
+          geometry_.lidar_origin_to_beam_origin_m * std::sin(theta_e), geometry_.beam_origin_z_m);
+      const Eigen::Vector3d origin_world = T_world_lidar * origin_lidar;
+      for (int row = 0; row < rows; ++row) {
+        const std::uint64_t pixel_id = static_cast<std::uint64_t>(col) * rows + row;
+        const double az = theta_e - geometry_.beam_azimuth_deg[row] * kDeg;
+        const double alt = geometry_.beam_altitude_deg[row] * kDeg;
+        const Eigen::Vector3d d_lidar(std::cos(az) * std::cos(alt), std::sin(az) * std::cos(alt),
+                                      std::sin(alt));
+        const Eigen::Vector3d d_world = R * d_lidar;
+        const Eigen::Vector3d e1 =
+            d_world
+                .cross(std::abs(d_world.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
+                                                   : Eigen::Vector3d::UnitX())
+                .normalized();
+        const Eigen::Vector3d e2 = d_world.cross(e1);
+        const double spin = 2.0 * kPi * hashUniform(seed_, index, pixel_id, 101);
+        int n_hits = 0;
+        for (int k = 0; k < k_rays; ++k) {
+          Eigen::Vector3d dir = d_world;
+          if (k > 0) {
+            const double a = spin + 2.0 * kPi * (k - 1) / (k_rays - 1);
+            dir =
+                (d_world + std::tan(ring_rad) * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
+          }
+          const auto hit = scene.castRay(origin_world, dir, 0.0, params_.max_range_m * 1.2);
+          if (!hit) continue;
+          const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(dir)));
+          hits[n_hits++] = {hit->range_m, k == 0 ? center_weight : ring_weight,
+                            reflectivity(hit->material) * cos_inc};
+        }
+        if (n_hits == 0) continue;
+        for (int i = 1; i < n_hits; ++i) {  // insertion sort by range (a handful of entries)
+          for (int j = i; j > 0 && hits[j].range_m < hits[j - 1].range_m; --j)
+            std::swap(hits[j], hits[j - 1]);
+        }
+        // Cluster the sub-ray returns by range: the nearest cluster and the one behind it.
+        auto cluster = [&](int first, double& w, double& r_mean, double& refl_mean) {
+          int i = first;
+          w = 0.0, r_mean = 0.0, refl_mean = 0.0;
+          while (i < n_hits && hits[i].range_m < hits[first].range_m + 0.2) {
+            w += hits[i].weight;
+            r_mean += hits[i].weight * hits[i].range_m;
+            refl_mean += hits[i].weight * hits[i].reflectivity_eff;
+            ++i;
+          }
+          r_mean /= w, refl_mean /= w;
+          return i;
+        };
+        double w_near, r_near, refl_near;
+        const int next = cluster(0, w_near, r_near, refl_near);
+        double r = r_near, weight = w_near, refl = refl_near;
+        if (w_near < 0.5 && next < n_hits) {
+          double w_far, r_far, refl_far;
+          cluster(next, w_far, r_far, refl_far);
+          if (r_far - r_near < 1.0) {  // one pulse with two overlapping echoes: a mixed range
+            r = (w_near * r_near + w_far * r_far) / (w_near + w_far);
+            weight = w_near + w_far;
+            refl = (w_near * refl_near + w_far * refl_far) / weight;
+          } else if (w_far > w_near) {  // the stronger, farther echo wins
+            r = r_far, weight = w_far, refl = refl_far;
+          }
+        }
+        // Detection: the energy returned decides the maximum range, with a soft edge.
+        const double energy = refl * weight;
+        const double r_max = params_.max_range_m * std::sqrt(energy / kReferenceReflectivity);
+        if (r < params_.min_range_m || r > r_max) continue;
+        if (params_.noise) {
+          const double edge = std::clamp((r - 0.8 * r_max) / (0.2 * r_max), 0.0, 1.0);
+          if (hashUniform(seed_, index, pixel_id, 102) <
+              std::max(params_.dropout_probability, edge))
+            continue;
+          r += (params_.range_noise_m + params_.range_noise_per_m * r) *
+               hashNormal(seed_, index, pixel_id, 103);
+        }
+        Pixel& px = pixels[pixel_id];
+        px.valid = true;
+        const Eigen::Vector3d p_lidar = origin_lidar + r * d_lidar;
+        px.p_sensor = (geometry_.T_sensor_lidar * p_lidar).cast<float>();
+        px.intensity = static_cast<float>(100.0 * refl);  // reflectivity in percent, as Ouster's
+      }
+    }
+  });
+
+  io::Scan scan;
+  scan.index = index;
+  scan.t_start_s = t_start_s + time_offset_s;
+  scan.t_end_s = t_start_s + (cols - 1) * dt_column + time_offset_s;
+  PointCloud& cloud = scan.cloud_in_lidar;
+  std::size_t valid = 0;
+  for (const Pixel& px : pixels) valid += px.valid ? 1 : 0;
+  cloud.reserve(valid);
+  for (int col = 0; col < cols; ++col) {
+    const double t = t_start_s + col * dt_column + time_offset_s;
+    for (int row = 0; row < rows; ++row) {
+      const Pixel& px = pixels[static_cast<std::size_t>(col) * rows + row];
+      if (!px.valid) continue;
+      cloud.positions.push_back(px.p_sensor.cast<double>());
+      cloud.times_s.push_back(t);
+      cloud.intensities.push_back(px.intensity);
+      cloud.rings.push_back(static_cast<std::uint16_t>(row));
+      cloud.columns.push_back(static_cast<std::uint16_t>(col));
+    }
+  }
+  return scan;
+}
+
+}  // namespace taiga::sim

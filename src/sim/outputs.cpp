@@ -1,0 +1,158 @@
+#include "outputs.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <stdexcept>
+
+#include "taiga/core/system_config.hpp"
+#include "taiga/io/config_yaml.hpp"
+
+namespace taiga::sim::detail {
+namespace {
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+
+void writeText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw std::runtime_error(fmt::format("{}: cannot write", path.string()));
+}
+
+const char* speciesName(Species s) {
+  switch (s) {
+    case Species::kPine:
+      return "pine";
+    case Species::kSpruce:
+      return "spruce";
+    case Species::kBirch:
+      return "birch";
+    case Species::kSapling:
+      return "sapling";
+  }
+  return "unknown";
+}
+}  // namespace
+
+void writeRigYaml(const std::filesystem::path& path, const Simulation& simulation) {
+  SystemConfig config;
+  config.rig.T_body_lidar = simulation.lidar().T_body_lidar();
+  config.rig.T_body_imu = lie::SE3();
+  config.rig.lidar_time_offset_s = 0.0;
+  config.rig.imu_acceleration_unit = AccelerationUnit::kMetersPerSecond2;
+  config.recording.lidar_topic = kLidarTopic;
+  config.recording.imu_topic = kImuTopic;
+  config.recording.gnss_topic = kGnssTopic;
+  config.recording.scan_period_s = simulation.lidar().scanPeriod_s();
+  const ImuParams& imu = simulation.scenario().imu;
+  const LidarParams& lidar = simulation.scenario().lidar;
+  std::string header = fmt::format(
+      "# Rig of a simulated recording (taiga simulate --scenario {} --seed {} --duration {}).\n"
+      "# Body = IMU frame; the lidar frame is the Ouster sensor frame (points as the Ouster ROS\n"
+      "# driver publishes them). Beam geometry: {}.\n"
+      "# Simulated noise (no config keys exist for these yet):\n"
+      "#   IMU {} Hz: accelerometer noise {} m/s^2/sqrt(Hz), bias walk {} m/s^3/sqrt(Hz), turn-on "
+      "{} m/s^2\n"
+      "#              gyroscope noise {} rad/s/sqrt(Hz), bias walk {} rad/s^2/sqrt(Hz), turn-on {} "
+      "rad/s\n"
+      "#   lidar: range noise {} m + {} m per m, divergence {} deg\n",
+      simulation.scenario().name, simulation.seed(), simulation.duration_s(),
+      simulation.lidar().geometry().source, imu.rate_hz, imu.accel_noise_density,
+      imu.accel_bias_random_walk, imu.accel_turn_on_bias, imu.gyro_noise_density,
+      imu.gyro_bias_random_walk, imu.gyro_turn_on_bias, lidar.range_noise_m,
+      lidar.range_noise_per_m, lidar.beam_divergence_deg);
+  writeText(path, header + io::writeConfigYaml(config));
+}
+
+void writeSceneJson(const std::filesystem::path& path, const Simulation& simulation,
+                    const SimulationSummary& summary) {
+  using nlohmann::json;
+  const Scenario& s = simulation.scenario();
+  const Scene& scene = simulation.scene();
+  json j;
+  j["scenario"] = s.name;
+  j["seed"] = simulation.seed();
+  j["duration_s"] = simulation.duration_s();
+  j["time_epoch_s"] = kRecordingEpoch_s;
+  j["world_frame"] = {
+      {"description",
+       "east-north-up at the origin below, z up; ground_truth.tum holds T_world_body"},
+      {"origin_latitude_deg", s.gnss.origin_latitude_deg},
+      {"origin_longitude_deg", s.gnss.origin_longitude_deg},
+      {"origin_height_ellipsoid_m", s.gnss.origin_height_m},
+      {"ellipsoid", "WGS84"}};
+  const SceneLayout& layout = scene.layout();
+  j["plot"] = {
+      {"center_x_m", layout.center_world.x()}, {"center_y_m", layout.center_world.y()},
+      {"half_size_m", layout.half_size_m},     {"area_ha", summary.scene.area_ha},
+      {"triangles", summary.scene.triangles},  {"curve_segments", summary.scene.curve_segments}};
+  j["forest"] = {
+      {"stems_per_ha", s.forest.stems_per_ha},   {"dbh_mean_m", s.forest.dbh_mean_m},
+      {"dbh_sigma_m", s.forest.dbh_sigma_m},     {"saplings_per_ha", s.forest.saplings_per_ha},
+      {"shrubs_per_ha", s.forest.shrubs_per_ha}, {"boulders_per_ha", s.forest.boulders_per_ha},
+      {"logs_per_ha", s.forest.logs_per_ha},     {"road_half_width_m", s.forest.road_half_width_m}};
+  const LidarSimulator& lidar = simulation.lidar();
+  j["lidar"] = {{"metadata", lidar.geometry().source},
+                {"rows", lidar.rows()},
+                {"columns", lidar.columns()},
+                {"rotation_hz", s.lidar.rotation_hz},
+                {"range_noise_m", s.lidar.range_noise_m},
+                {"range_noise_per_m", s.lidar.range_noise_per_m},
+                {"beam_divergence_deg", s.lidar.beam_divergence_deg},
+                {"sub_rays", s.lidar.sub_rays},
+                {"max_range_m", s.lidar.max_range_m},
+                {"dropout_probability", s.lidar.dropout_probability}};
+  j["imu"] = {{"rate_hz", s.imu.rate_hz},
+              {"accel_noise_density", s.imu.accel_noise_density},
+              {"gyro_noise_density", s.imu.gyro_noise_density},
+              {"accel_bias_random_walk", s.imu.accel_bias_random_walk},
+              {"gyro_bias_random_walk", s.imu.gyro_bias_random_walk},
+              {"accel_turn_on_bias", s.imu.accel_turn_on_bias},
+              {"gyro_turn_on_bias", s.imu.gyro_turn_on_bias},
+              {"gravity_mps2", s.imu.gravity_mps2}};
+  j["gnss"] = {{"rate_hz", s.gnss.rate_hz},
+               {"sigma_open_horizontal_m", s.gnss.sigma_open_horizontal_m},
+               {"sigma_canopy_horizontal_m", s.gnss.sigma_canopy_horizontal_m},
+               {"reported_sigma_factor", s.gnss.reported_sigma_factor}};
+  j["summary"] = {{"scans", summary.scans},
+                  {"imu_samples", summary.imu_samples},
+                  {"gnss_fixes", summary.gnss_fixes},
+                  {"points", summary.points},
+                  {"min_points_per_scan", summary.min_points_per_scan},
+                  {"max_points_per_scan", summary.max_points_per_scan},
+                  {"path_length_m", summary.path_length_m},
+                  {"loop_period_s", simulation.motion().loopPeriod_s()}};
+  json trees = json::array();
+  for (const Tree& t : scene.trees()) {
+    trees.push_back({{"x_m", t.base_world.x()},
+                     {"y_m", t.base_world.y()},
+                     {"z_m", t.base_world.z()},
+                     {"dbh_m", t.dbh_m},
+                     {"height_m", t.height_m},
+                     {"lean_deg", t.lean_rad * kRadToDeg},
+                     {"lean_azimuth_deg", t.lean_azimuth_rad * kRadToDeg},
+                     {"crown_base_m", t.crown_base_m},
+                     {"species", speciesName(t.species)}});
+  }
+  j["trees"] = std::move(trees);
+  json boulders = json::array();
+  for (const Boulder& b : scene.boulders()) {
+    boulders.push_back({{"x_m", b.center_world.x()},
+                        {"y_m", b.center_world.y()},
+                        {"z_m", b.center_world.z()},
+                        {"radius_m", b.radius_m}});
+  }
+  j["boulders"] = std::move(boulders);
+  json logs = json::array();
+  for (const FallenLog& l : scene.logs()) {
+    logs.push_back({{"start_m", {l.start_world.x(), l.start_world.y(), l.start_world.z()}},
+                    {"end_m", {l.end_world.x(), l.end_world.y(), l.end_world.z()}},
+                    {"radius_m", l.radius_m}});
+  }
+  j["logs"] = std::move(logs);
+  writeText(path, j.dump(1) + "\n");
+}
+
+}  // namespace taiga::sim::detail

@@ -1,0 +1,101 @@
+#include "taiga/sim/simulator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "outputs.hpp"
+#include "taiga/core/trajectory.hpp"
+#include "taiga/io/rosbag.hpp"
+#include "taiga/io/trajectory_io.hpp"
+
+namespace taiga::sim {
+namespace {
+/// Beyond the loop, the plot extends this far: about the useful range of the lidar, m.
+constexpr double kPlotMargin_m = 35.0;
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+Simulation::Simulation(const Scenario& scenario, double duration_s, std::uint64_t seed)
+    : scenario_(scenario), duration_s_(duration_s), seed_(seed) {
+  motion_ = std::make_unique<WalkingMotion>(scenario.motion, duration_s, seed,
+                                            Terrain(scenario.forest, seed));
+  SceneLayout layout;
+  layout.center_world = motion_->loopCenter();
+  layout.half_size_m = motion_->loopHalfExtent_m() + kPlotMargin_m;
+  layout.keep_out_path = motion_->loopPolyline(0.5);
+  scene_ = std::make_unique<Scene>(scenario.forest, seed, std::move(layout));
+  lidar_ =
+      std::make_unique<LidarSimulator>(scenario.lidar, loadLidarGeometry(scenario.lidar), seed);
+}
+
+std::size_t Simulation::scanCount() const {
+  return static_cast<std::size_t>(std::floor(duration_s_ / lidar_->scanPeriod_s() + 1e-9));
+}
+
+SimulationSummary writeSimulation(const Simulation& simulation,
+                                  const std::filesystem::path& out_dir,
+                                  const std::function<void(std::size_t, std::size_t)>& on_scan) {
+  const auto start = std::chrono::steady_clock::now();
+  std::filesystem::create_directories(out_dir);
+  const Scenario& scenario = simulation.scenario();
+  const WalkingMotion& motion = simulation.motion();
+  const Scene& scene = simulation.scene();
+  const LidarSimulator& lidar = simulation.lidar();
+
+  SimulationSummary summary;
+  summary.trees = scene.trees().size();
+  summary.scene = scene.stats();
+  summary.min_points_per_scan = std::numeric_limits<std::size_t>::max();
+
+  io::BagWriter bag(out_dir / "recording.bag");
+  ImuSimulator imu(scenario.imu, simulation.seed());
+  GnssSimulator gnss(scenario.gnss, simulation.seed());
+  Trajectory ground_truth;
+  auto emitUntil = [&](double t_end_s) {
+    while (imu.nextTime_s() <= t_end_s) {
+      const double t = imu.nextTime_s();
+      const ImuSample sample = imu.next(motion, kRecordingEpoch_s);
+      bag.writeImu(kImuTopic, "os_imu", sample);
+      ground_truth.append(sample.t_s, motion.at(t).T_world_body);
+      ++summary.imu_samples;
+    }
+    while (gnss.nextTime_s() <= t_end_s) {
+      if (const auto fix = gnss.next(motion, scene, kRecordingEpoch_s)) {
+        bag.writeGnss(kGnssTopic, "gnss", *fix);
+        ++summary.gnss_fixes;
+      }
+    }
+  };
+
+  const std::size_t scans = simulation.scanCount();
+  const io::ScanGrid grid{static_cast<std::uint32_t>(lidar.rows()),
+                          static_cast<std::uint32_t>(lidar.columns())};
+  for (std::size_t k = 0; k < scans; ++k) {
+    const double t_start = static_cast<double>(k) * lidar.scanPeriod_s();
+    const io::Scan scan = lidar.simulateScan(scene, motion, k, t_start, kRecordingEpoch_s);
+    emitUntil(scan.t_end_s - kRecordingEpoch_s);
+    bag.writeScan(kLidarTopic, "os_sensor", scan, grid);
+    const std::size_t n = scan.cloud_in_lidar.size();
+    summary.points += n;
+    summary.min_points_per_scan = std::min(summary.min_points_per_scan, n);
+    summary.max_points_per_scan = std::max(summary.max_points_per_scan, n);
+    ++summary.scans;
+    if (on_scan) on_scan(k + 1, scans);
+  }
+  emitUntil(simulation.duration_s());
+  bag.close();
+  if (summary.scans == 0) summary.min_points_per_scan = 0;
+  summary.path_length_m = ground_truth.size() > 1 ? ground_truth.pathLength() : 0.0;
+
+  io::writeTum(out_dir / "ground_truth.tum", ground_truth);
+  detail::writeRigYaml(out_dir / "rig.yaml", simulation);
+  summary.simulate_s = secondsSince(start);
+  detail::writeSceneJson(out_dir / "scene.json", simulation, summary);
+  return summary;
+}
+
+}  // namespace taiga::sim

@@ -1,0 +1,128 @@
+// The simulated lidar: deterministic whatever the thread count, points on true surfaces when
+// transformed by the true pose at their column's time, sensible returns per scan.
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "taiga/sim/simulator.hpp"
+
+namespace taiga::sim {
+namespace {
+
+/// A reduced head (32 x 512) keeps the tests fast; the geometry code is the same.
+Scenario smallScenario(bool noise) {
+  Scenario s = scenarioByName("mixed");
+  s.lidar.beams = 32;
+  s.lidar.columns = 512;
+  s.lidar.noise = noise;
+  if (!noise) s.lidar.sub_rays = 1;
+  return s;
+}
+
+/// Distances from every point (in the world at its own time) to the nearest true surface.
+std::vector<double> surfaceDistances(const Simulation& sim, const io::Scan& scan) {
+  const lie::SE3 T_body_lidar = sim.lidar().T_body_lidar();
+  std::vector<double> d;
+  const PointCloud& cloud = scan.cloud_in_lidar;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const lie::SE3 T_world_body = sim.motion().at(cloud.times_s[i]).T_world_body;
+    d.push_back(
+        sim.scene().distanceToSurface(T_world_body * (T_body_lidar * cloud.positions[i]), 2.0));
+  }
+  std::sort(d.begin(), d.end());
+  return d;
+}
+
+double quantile(const std::vector<double>& sorted, double q) {
+  return sorted[static_cast<std::size_t>(q * (sorted.size() - 1))];
+}
+
+TEST(Lidar, SameSeedGivesBitIdenticalScansWhateverTheThreadCount) {
+  const Simulation a(smallScenario(true), 2.0, 4), b(smallScenario(true), 2.0, 4);
+  io::Scan one, two;
+  tbb::task_arena(1).execute([&] { one = a.lidar().simulateScan(a.scene(), a.motion(), 0, 0.0); });
+  tbb::task_arena(2).execute([&] { two = b.lidar().simulateScan(b.scene(), b.motion(), 0, 0.0); });
+  ASSERT_GT(one.cloud_in_lidar.size(), 1000u);
+  ASSERT_EQ(one.cloud_in_lidar.size(), two.cloud_in_lidar.size());
+  EXPECT_EQ(one.cloud_in_lidar.positions, two.cloud_in_lidar.positions);
+  EXPECT_EQ(one.cloud_in_lidar.times_s, two.cloud_in_lidar.times_s);
+  EXPECT_EQ(one.cloud_in_lidar.intensities, two.cloud_in_lidar.intensities);
+  EXPECT_EQ(one.cloud_in_lidar.rings, two.cloud_in_lidar.rings);
+  // Another seed is another forest.
+  const Simulation c(smallScenario(true), 2.0, 5);
+  const io::Scan three = c.lidar().simulateScan(c.scene(), c.motion(), 0, 0.0);
+  EXPECT_NE(one.cloud_in_lidar.positions, three.cloud_in_lidar.positions);
+}
+
+TEST(Lidar, NoiselessPointsLieOnTheSceneAtTheirColumnsPose) {
+  const Simulation sim(smallScenario(false), 2.0, 2);
+  const io::Scan scan = sim.lidar().simulateScan(sim.scene(), sim.motion(), 3, 0.3);
+  ASSERT_GT(scan.cloud_in_lidar.size(), 3000u);
+  const std::vector<double> d = surfaceDistances(sim, scan);
+  EXPECT_LT(quantile(d, 0.5), 2e-3);  // float32 geometry only
+  EXPECT_LT(quantile(d, 0.99), 1e-2);
+  // With a single pose for the whole sweep instead, the motion during the 0.1 s skews the scan.
+  const lie::SE3 T_body_lidar = sim.lidar().T_body_lidar();
+  const lie::SE3 T_world_body_start = sim.motion().at(scan.t_start_s).T_world_body;
+  std::vector<double> skewed;
+  for (std::size_t i = 0; i < scan.cloud_in_lidar.size(); ++i) {
+    if (scan.cloud_in_lidar.columns[i] < 400) continue;  // late columns: largest skew
+    skewed.push_back(sim.scene().distanceToSurface(
+        T_world_body_start * (T_body_lidar * scan.cloud_in_lidar.positions[i]), 2.0));
+  }
+  std::sort(skewed.begin(), skewed.end());
+  EXPECT_GT(quantile(skewed, 0.5), 10 * quantile(d, 0.5));
+}
+
+TEST(Lidar, NoisyPointsLieOnTheSceneWithinTheRangeNoise) {
+  const Simulation sim(smallScenario(true), 2.0, 2);
+  const io::Scan scan = sim.lidar().simulateScan(sim.scene(), sim.motion(), 3, 0.3);
+  const std::vector<double> d = surfaceDistances(sim, scan);
+  const double median = quantile(d, 0.5);
+  // Range noise of 1 cm + 0.05 % of the range, seen along the ray: median |error| ~ 0.67 sigma.
+  EXPECT_GT(median, 0.003);
+  EXPECT_LT(median, 0.03);
+  // Mixed edge returns put some points between foreground and background.
+  EXPECT_GT(quantile(d, 0.995), 0.08);
+}
+
+TEST(Lidar, ScanTimesColumnsAndReturns) {
+  const Simulation sim(smallScenario(true), 2.0, 2);
+  const io::Scan scan = sim.lidar().simulateScan(sim.scene(), sim.motion(), 5, 0.5, 100.0);
+  const PointCloud& c = scan.cloud_in_lidar;
+  ASSERT_TRUE(c.isConsistent());
+  EXPECT_DOUBLE_EQ(scan.t_start_s, 100.5);
+  EXPECT_NEAR(scan.t_end_s - scan.t_start_s, 0.1 * 511.0 / 512.0, 1e-12);
+  EXPECT_TRUE(std::is_sorted(c.times_s.begin(), c.times_s.end()));
+  EXPECT_GE(c.times_s.front(), scan.t_start_s);
+  EXPECT_LE(c.times_s.back(), scan.t_end_s);
+  const double fraction = static_cast<double>(c.size()) / (32.0 * 512.0);
+  EXPECT_GT(fraction, 0.4);  // the sky above the canopy gaps and far ground give no return
+  EXPECT_LT(fraction, 0.98);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const double range = c.positions[i].norm();
+    ASSERT_GT(range, 0.4);
+    ASSERT_LT(range, 46.0);
+  }
+}
+
+TEST(Lidar, HeadsOfOtherSizesAndTheFallbackGeometry) {
+  LidarParams params;
+  params.beams = 64;
+  const LidarGeometry g = loadLidarGeometry(params);
+  ASSERT_EQ(g.beam_altitude_deg.size(), 64u);
+  EXPECT_GT(g.beam_altitude_deg.front(), 40.0);  // OS0: about +-45 deg
+  EXPECT_LT(g.beam_altitude_deg.back(), -40.0);
+  params.metadata_json = "does/not/exist.json";
+  const LidarGeometry fallback = loadLidarGeometry(params);
+  EXPECT_EQ(fallback.source, "uniform fallback");
+  EXPECT_DOUBLE_EQ(fallback.beam_altitude_deg.front(), 45.0);
+  EXPECT_DOUBLE_EQ(fallback.beam_altitude_deg.back(), -45.0);
+  // Both give the same rig: T_body_lidar from the OS0's IMU and sensor frames.
+  EXPECT_LT((g.T_sensor_imu.translation() - fallback.T_sensor_imu.translation()).norm(), 1e-9);
+}
+
+}  // namespace
+}  // namespace taiga::sim
