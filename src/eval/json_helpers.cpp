@@ -9,6 +9,9 @@ using nlohmann::json;
 json number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
 json statisticsJson(const ErrorStatistics& s) {
+  if (s.count == 0)  // no values: no statistics
+    return {{"count", 0},     {"rmse", nullptr}, {"mean", nullptr}, {"median", nullptr},
+            {"std", nullptr}, {"min", nullptr},  {"max", nullptr},  {"sse", nullptr}};
   return {{"count", s.count},           {"rmse", number(s.rmse)}, {"mean", number(s.mean)},
           {"median", number(s.median)}, {"std", number(s.std)},   {"min", number(s.min)},
           {"max", number(s.max)},       {"sse", number(s.sse)}};

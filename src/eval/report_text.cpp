@@ -120,6 +120,11 @@ std::string formatEvalText(const EvalReport& report) {
                      "rmse", "mean", "median", "std", "min", "max");
   for (const StatsRow& row : statsRows(report)) {
     const ErrorStatistics& s = row.stats;
+    if (s.count == 0) {
+      out += fmt::format("{:<40} {:>8} (no pairs: the trajectory is shorter than the delta)\n",
+                         row.name, 0);
+      continue;
+    }
     out += fmt::format("{:<40} {:>8} {:>12.6f} {:>12.6f} {:>12.6f} {:>12.6f} {:>12.6f} {:>12.6f}\n",
                        row.name, s.count, s.rmse, s.mean, s.median, s.std, s.min, s.max);
   }
@@ -141,6 +146,10 @@ std::string formatEvalMarkdown(const EvalReport& report) {
   out += "|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const StatsRow& row : statsRows(report)) {
     const ErrorStatistics& s = row.stats;
+    if (s.count == 0) {
+      out += fmt::format("| {} | 0 | - | - | - | - | - | - |\n", row.name);
+      continue;
+    }
     out += fmt::format("| {} | {} | {:.6f} | {:.6f} | {:.6f} | {:.6f} | {:.6f} | {:.6f} |\n",
                        row.name, s.count, s.rmse, s.mean, s.median, s.std, s.min, s.max);
   }

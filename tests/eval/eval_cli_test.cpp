@@ -87,6 +87,14 @@ TEST(EvalCli, ConstantOffsetIsThreeMetresUnalignedAndZeroAligned) {
   EXPECT_THAT(text.output, HasSubstr("APE rotation (deg)"));
   EXPECT_THAT(text.output, HasSubstr("[3.00, 3.10) m"));
 
+  const Result long_delta = runTaiga(
+      "eval --est " + f.est.string() + " --ref " + f.ref.string() + " --rpe-delta 500 --json",
+      false);
+  ASSERT_EQ(long_delta.exit_code, 0) << long_delta.output;
+  const nlohmann::json rpe = nlohmann::json::parse(long_delta.output)["rpe"][0];
+  EXPECT_EQ(rpe["pairs"], 0);
+  EXPECT_TRUE(rpe["translation_m"]["rmse"].is_null());
+
   const Result markdown = runTaiga(
       "eval --est " + f.est.string() + " --ref " + f.ref.string() + " --align none --markdown",
       false);
