@@ -27,8 +27,8 @@ lie::Vector6 newtonStep(const lie::Matrix6& H, const lie::Vector6& g) {
   return -(V * lambda.cwiseInverse().asDiagonal() * V.transpose()) * g;
 }
 
-RegistrationResult newton(const Evaluate& evaluate, const lie::SE3& guess,
-                          const NdtConfig& config) {
+RegistrationResult newton(const Evaluate& evaluate, const lie::SE3& guess, const NdtConfig& config,
+                          double max_step_m) {
   RegistrationResult result;
   lie::SE3 T = guess;
   NdtDerivatives D = evaluate(T, true);
@@ -37,21 +37,28 @@ RegistrationResult newton(const Evaluate& evaluate, const lie::SE3& guess,
     if (D.num_inliers == 0) break;
     lie::Vector6 step = newtonStep(D.hessian, D.gradient);
     const double step_m = step.head<3>().norm();
-    if (step_m > config.max_step_m) step *= config.max_step_m / step_m;
+    if (step_m > max_step_m) step *= max_step_m / step_m;
+    result.iterations = it;
+    if (step.head<3>().norm() < config.step_epsilon_m &&
+        step.tail<3>().norm() < config.step_epsilon_rad) {
+      small_step = true;  // the full Newton step is below the tolerance: done, without taking it
+      break;
+    }
+    // Backtracking (Armijo) line search. The full step is evaluated with derivatives, since it
+    // is usually accepted; shorter ones with the score only, then derivatives where accepted.
     const double slope = D.gradient.dot(step);  // < 0 for a descent direction
     double alpha = 1.0;
     bool accepted = false;
     for (int ls = 0; ls < kMaxLineSearchSteps; ++ls, alpha *= 0.5) {
       const lie::SE3 candidate = T.plus(alpha * step);
-      NdtDerivatives Dc = evaluate(candidate, true);
+      NdtDerivatives Dc = evaluate(candidate, ls == 0);
       if (Dc.score <= D.score + 1e-4 * alpha * slope) {
         T = candidate;
-        D = std::move(Dc);
+        D = ls == 0 ? std::move(Dc) : evaluate(T, true);
         accepted = true;
         break;
       }
     }
-    result.iterations = it;
     const lie::Vector6 taken = accepted ? lie::Vector6(alpha * step) : lie::Vector6::Zero();
     // No decrease along a descent direction within 2^-10 of the step: at the minimum to within
     // the resolution of the line search.
@@ -131,7 +138,7 @@ RegistrationResult alignNdt(std::span<const Eigen::Vector3d> source, const NdtTa
       [&](const lie::SE3& T, bool with_hessian) {
         return ndtDerivatives(source, target, T, config, with_hessian);
       },
-      guess, config);
+      guess, config, config.max_step_cells * target.resolution_m());
 }
 
 RegistrationResult alignNdt(std::span<const Eigen::Vector3d> source,
@@ -163,7 +170,7 @@ RegistrationResult alignD2dNdt(std::span<const Eigen::Vector3d> source, const Nd
       [&](const lie::SE3& T, bool with_hessian) {
         return d2dDerivatives(cells, target, T, config, with_hessian);
       },
-      guess, config);
+      guess, config, config.max_step_cells * target.resolution_m());
 }
 
 RegistrationResult alignD2dNdt(std::span<const Eigen::Vector3d> source,

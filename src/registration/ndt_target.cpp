@@ -26,7 +26,7 @@ void NdtConfig::validate() const {
   if (max_iterations < 1) fail("max_iterations", ">= 1", max_iterations);
   if (!(step_epsilon_m > 0.0)) fail("step_epsilon_m", "> 0 m", step_epsilon_m);
   if (!(step_epsilon_rad > 0.0)) fail("step_epsilon_rad", "> 0 rad", step_epsilon_rad);
-  if (!(max_step_m > 0.0)) fail("max_step_m", "> 0 m", max_step_m);
+  if (!(max_step_cells > 0.0)) fail("max_step_cells", "> 0", max_step_cells);
 }
 
 NdtConstants ndtConstants(double resolution_m, double outlier_ratio) {

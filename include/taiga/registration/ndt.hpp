@@ -50,7 +50,10 @@ struct NdtConfig {
   int max_iterations = 35;              ///< per resolution
   double step_epsilon_m = 1e-3;         ///< converged when the translation step is below this...
   double step_epsilon_rad = 1e-4;       ///< ...and the rotation step below this
-  double max_step_m = 0.5;              ///< a longer Newton translation step is scaled down
+  /// A Newton step translating more than this many cell edges is scaled down (0.1 of a 1 m cell
+  /// took 11 iterations from 0.5 m / 5 deg on the test pair, 0.5 took 19: the score is not
+  /// convex far from the minimum, and long steps overshoot).
+  double max_step_cells = 0.1;
   /// Planarity check of the source: degenerate when the smallest eigenvalue of the source
   /// covariance is below this fraction of the largest.
   double planar_eigenvalue_ratio = 1e-6;
