@@ -123,6 +123,29 @@ TEST(EvalCli, OffsetToleranceAndSim3) {
   EXPECT_NEAR(j["ape"]["translation_m"]["rmse"].get<double>(), 0.0, 1e-9);
 }
 
+TEST(EvalCli, KittiFilesAndTheKittiErrorOfAOnePercentScaleError) {
+  // 1000 m along x in 1 m steps, in KITTI format (times are line indices); the estimate is 1 %
+  // too long. Each devkit segment spans L + 1 m, hence 1.0044 % rather than 1 % (metrics_test).
+  taiga::test::TempDir dir;
+  taiga::Trajectory ref, est;
+  for (int i = 0; i <= 1000; ++i) {
+    ref.append(i, taiga::lie::SE3(taiga::lie::SO3(), {1.0 * i, 0.0, 0.0}));
+    est.append(i, taiga::lie::SE3(taiga::lie::SO3(), {1.01 * i, 0.0, 0.0}));
+  }
+  taiga::io::writeKitti(dir.file("ref.txt"), ref);
+  taiga::io::writeKitti(dir.file("est.txt"), est);
+  const Result r = runTaiga("eval --est " + dir.file("est.txt").string() + " --ref " +
+                                dir.file("ref.txt").string() + " --align none --json",
+                            false);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["association"]["pairs"], 1001);
+  EXPECT_EQ(j["kitti"]["segments"], 440);
+  EXPECT_NEAR(j["kitti"]["translation_error_percent"].get<double>(), 1.004358766233766, 1e-9);
+  EXPECT_NEAR(j["drift"]["drift_m"].get<double>(), 10.0, 1e-9);  // 1010 m instead of 1000 m
+  EXPECT_NEAR(j["drift"]["drift_percent"].get<double>(), 1.0, 1e-9);
+}
+
 TEST(EvalCli, TimingStatisticsFromACsv) {
   Files f;
   const fs::path timing = f.dir.write(
