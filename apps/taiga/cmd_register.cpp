@@ -56,6 +56,10 @@ std::vector<Eigen::Vector3d> readPositions(const std::string& path, const std::s
   return points;
 }
 
+std::string finiteOrNull(double value) {
+  return std::isfinite(value) ? fmt::format("{:.6g}", value) : "null";
+}
+
 std::string formatResult(const RegisterOptions& o, const registration::RegistrationResult& r,
                          double time_ms, std::size_t n_source, std::size_t n_target) {
   const Eigen::Matrix4d T = r.T_target_source.matrix();
@@ -84,9 +88,10 @@ std::string formatResult(const RegisterOptions& o, const registration::Registrat
     out = fmt::format(
         "{{\"method\": \"{}\", \"T_target_source\": [{}], \"converged\": {}, \"reason\": \"{}\", "
         "\"iterations\": {}, \"num_inliers\": {}, \"fitness_m2\": {}, \"hessian_condition\": {}, "
-        "\"time_ms\": {:.3f}, \"source_points\": {}, \"target_points\": {}}}\n",
+        "\"translation_condition\": {}, \"time_ms\": {:.3f}, \"source_points\": {}, "
+        "\"target_points\": {}}}\n",
         o.method, rows, r.converged, reason, r.iterations, r.num_inliers, fitness, condition,
-        time_ms, n_source, n_target);
+        finiteOrNull(r.translation_condition), time_ms, n_source, n_target);
   } else {
     out += fmt::format("method: {}\nT_target_source:\n", o.method);
     for (int i = 0; i < 4; ++i) {

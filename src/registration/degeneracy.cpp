@@ -15,6 +15,14 @@ double conditionNumber(const lie::Matrix6& H) {
   return hi / lo;
 }
 
+double translationConditionNumber(const lie::Matrix6& H) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(H.topLeftCorner<3, 3>(),
+                                                        Eigen::EigenvaluesOnly);
+  const double lo = solver.eigenvalues()(0);
+  if (!(lo > 0.0)) return std::numeric_limits<double>::infinity();
+  return solver.eigenvalues()(2) / lo;
+}
+
 double planarityRatio(std::span<const Eigen::Vector3d> points) {
   if (points.size() < 3) return 0.0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();

@@ -72,6 +72,9 @@ void GicpConfig::validate() const {
     fail("max_correspondence_distance_m", "> 0 m", max_correspondence_distance_m);
   }
   if (max_iterations < 1) fail("max_iterations", ">= 1", max_iterations);
+  if (!(max_translation_condition >= 1.0)) {
+    fail("max_translation_condition", ">= 1", max_translation_condition);
+  }
   if (!(step_epsilon_m > 0.0)) fail("step_epsilon_m", "> 0 m", step_epsilon_m);
   if (!(step_epsilon_rad > 0.0)) fail("step_epsilon_rad", "> 0 rad", step_epsilon_rad);
 }
@@ -136,12 +139,17 @@ RegistrationResult alignGicp(const GicpCloud& source, const GicpCloud& target,
   result.num_inliers = lin.num_inliers;
   result.hessian = lin.H;
   result.hessian_condition = conditionNumber(lin.H);
+  result.translation_condition = translationConditionNumber(lin.H);
   result.cost = lin.error;
   if (lin.num_inliers < 6) {
     result.reason = "too few correspondences within max_correspondence_distance_m (" +
                     std::to_string(lin.num_inliers) + ")";
   } else if (!std::isfinite(result.hessian_condition)) {
     result.reason = "Hessian not positive definite (degenerate geometry)";
+  } else if (result.translation_condition > config.max_translation_condition) {
+    result.reason = "degenerate: a translation is poorly constrained (condition number " +
+                    std::to_string(result.translation_condition) +
+                    " of the Hessian's translation block)";
   } else if (!small_step) {
     result.reason =
         "no convergence within max_iterations (" + std::to_string(config.max_iterations) + ")";

@@ -69,6 +69,7 @@ RegistrationResult newton(const Evaluate& evaluate, const lie::SE3& guess, const
   result.num_inliers = D.num_inliers;
   result.hessian = D.hessian;
   result.hessian_condition = conditionNumber(D.hessian);
+  result.translation_condition = translationConditionNumber(D.hessian);
   result.cost = D.score;
   if (D.num_inliers == 0) {
     result.reason = "no source point falls into a target cell";
@@ -77,6 +78,10 @@ RegistrationResult newton(const Evaluate& evaluate, const lie::SE3& guess, const
         "no convergence within max_iterations (" + std::to_string(config.max_iterations) + ")";
   } else if (!std::isfinite(result.hessian_condition)) {
     result.reason = "Hessian not positive definite at the result (degenerate geometry)";
+  } else if (result.translation_condition > config.max_translation_condition) {
+    result.reason = "degenerate: a translation is poorly constrained (condition number " +
+                    std::to_string(result.translation_condition) +
+                    " of the Hessian's translation block)";
   } else {
     result.converged = true;
   }

@@ -24,6 +24,9 @@ void NdtConfig::validate() const {
     fail("min_eigenvalue_ratio", "(0, 1]", min_eigenvalue_ratio);
   }
   if (max_iterations < 1) fail("max_iterations", ">= 1", max_iterations);
+  if (!(max_translation_condition >= 1.0)) {
+    fail("max_translation_condition", ">= 1", max_translation_condition);
+  }
   if (!(step_epsilon_m > 0.0)) fail("step_epsilon_m", "> 0 m", step_epsilon_m);
   if (!(step_epsilon_rad > 0.0)) fail("step_epsilon_rad", "> 0 rad", step_epsilon_rad);
   if (!(max_step_cells > 0.0)) fail("max_step_cells", "> 0", max_step_cells);

@@ -31,6 +31,9 @@ struct GicpConfig {
   /// Degenerate input when the smallest eigenvalue of a cloud's covariance is below this
   /// fraction of the largest.
   double planar_eigenvalue_ratio = 1e-6;
+  /// Degenerate result when the condition number of the Hessian's translation block exceeds
+  /// this (see RegistrationResult::translation_condition).
+  double max_translation_condition = 50.0;
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
 };

@@ -26,6 +26,11 @@ struct RegistrationResult {
   /// Ratio of the largest to the smallest eigenvalue of `hessian` (infinite when the smallest is
   /// not positive): large values mean a direction the data does not constrain.
   double hessian_condition = std::numeric_limits<double>::infinity();
+  /// Condition number of the translation block (rho, rho) of `hessian`: unit-free, about 2-3 for
+  /// the real test pair and 77-275 for a corridor (two walls and a floor) whose length leaves a
+  /// translation unconstrained. Above the method's max_translation_condition the result is
+  /// reported as degenerate (converged = false).
+  double translation_condition = std::numeric_limits<double>::infinity();
   /// Final value of the minimized cost (NDT: negative log-likelihood score; GICP: sum of squared
   /// Mahalanobis distances).
   double cost = 0.0;
@@ -39,5 +44,7 @@ struct RegistrationResult {
 /// Condition number (largest / smallest eigenvalue) of a symmetric 6x6 matrix; infinity when the
 /// smallest eigenvalue is not positive.
 double conditionNumber(const lie::Matrix6& H);
+/// The same for the 3x3 translation block of H.
+double translationConditionNumber(const lie::Matrix6& H);
 
 }  // namespace taiga::registration
