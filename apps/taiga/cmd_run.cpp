@@ -1,14 +1,46 @@
-// taiga run: lidar-inertial SLAM over a recording.
+// taiga run: lidar-inertial odometry over a recording, with the outputs of pipeline/run.hpp.
+#include <fmt/format.h>
+
 #include <memory>
 
 #include "command.hpp"
+#include "recording_options.hpp"
+#include "taiga/core/config.hpp"
+#include "taiga/pipeline/run.hpp"
 
 namespace taiga::app {
 namespace {
 struct RunOptions {
   std::string recording, config, out;
   bool realtime = false;
+  bool ply = false;
+  double map_voxel_m = 0.0;
 };
+
+int run(const RunOptions& options) {
+  SystemConfig config = loadConfig(options.config);
+  validateAll(config);
+  const pipeline::RunSummary s = pipeline::runOdometry(options.recording, config,
+                                                       {.out_dir = options.out,
+                                                        .write_ply = options.ply,
+                                                        .map_voxel_m = options.map_voxel_m,
+                                                        .realtime = options.realtime});
+  fmt::print("scans      {} read, {} processed; {} IMU samples; {:.1f} s, {:.1f} m of path\n",
+             s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
+  fmt::print("lidar      {} registrations rejected, {} inflated; {} keyframes, {} map points\n",
+             s.lidar_rejected, s.lidar_inflated, s.keyframes, s.map_points);
+  fmt::print(
+      "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {:.2f}x real time; peak "
+      "memory {:.0f} MB\n",
+      s.mean_ms, s.p95_ms, s.max_ms, s.realtime_factor, s.peak_memory_mb);
+  fmt::print(
+      "outputs    {}/ (trajectory.tum, trajectory_imu.tum, keyframes.tum, map.las{}, timing.csv, "
+      "scans.csv, "
+      "summary.json)\n",
+      options.out, options.ply ? ", map.ply" : "");
+  return kExitOk;
+}
+
 }  // namespace
 
 Command addRunCommand(CLI::App& tool) {
@@ -17,11 +49,15 @@ Command addRunCommand(CLI::App& tool) {
       "run", "Estimate the trajectory and build the forest map from a recording");
   parser->add_option("RECORDING", options->recording, "ROS1 bag, Ouster pcap or folder")
       ->required();
-  parser->add_option("--config", options->config, "YAML configuration (see `taiga config`)");
+  addConfigOption(*parser, options->config);
   parser->add_option("--out", options->out, "Output directory")->required();
   parser->add_flag("--realtime", options->realtime, "Play the recording at sensor rate");
-  return {parser, notImplemented("run", "the odometry pipeline is issue 6, mapping issue 7"),
-          options};
+  parser->add_flag("--ply", options->ply, "Also write map.ply");
+  parser
+      ->add_option("--map-voxel", options->map_voxel_m,
+                   "Decimate the map to one point per voxel of this size, m")
+      ->check(CLI::NonNegativeNumber);
+  return {parser, [options] { return run(*options); }, options};
 }
 
 }  // namespace taiga::app

@@ -50,6 +50,9 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.field("keyframe_rotation_weight_m_per_rad", keyframe_rotation_weight_m_per_rad,
           "m/rad, weight of rotation in the travelled distance");
   v.field("window_states", window_states, "states in the odometry graph's fixed-lag window (>= 2)");
+  v.field("gravity_alignment_s", gravity_alignment_s,
+          "s, span of the first scans used to level the world frame with lidar and IMU (0: IMU "
+          "attitude only)");
   v.section("imu", imu, "IMU noise model");
 }
 
@@ -71,6 +74,7 @@ void OdometryConfig::validate() const {
   requireNonNegative("keyframe_rotation_weight_m_per_rad", keyframe_rotation_weight_m_per_rad,
                      "m/rad");
   requireInRange("window_states", window_states, 2, 50, "states");
+  requireInRange("gravity_alignment_s", gravity_alignment_s, 0.0, 30.0, "s");
 }
 
 }  // namespace taiga

@@ -19,6 +19,10 @@ std::string formatDuration(double seconds) {
 std::string formatProgressLine(const std::string& label, std::size_t done, std::size_t total,
                                const std::string& unit, double elapsed_s) {
   const double rate = elapsed_s > 0.0 ? static_cast<double>(done) / elapsed_s : 0.0;
+  if (total == 0) {  // total unknown: count, rate and elapsed time only
+    return fmt::format("{}  {} {}  {:.1f} {}/s  elapsed {}", label, done, unit, rate, unit,
+                       formatDuration(elapsed_s));
+  }
   const double remaining_s =
       rate > 0.0 && total >= done ? static_cast<double>(total - done) / rate : -1.0;
   const double percent =

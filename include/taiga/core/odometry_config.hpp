@@ -44,6 +44,9 @@ struct OdometryConfig final : ConfigSection {
   double keyframe_rotation_weight_m_per_rad = 2.0;
   // Odometry graph.
   int window_states = 5;
+  /// Span of the first scans whose lidar poses and IMU increments level the world frame (gravity
+  /// alignment, imu/gravity_alignment.hpp), s; 0 keeps the attitude from the IMU alone.
+  double gravity_alignment_s = 2.0;
   ImuNoiseConfig imu;
 
   void visit(ConfigVisitor& v) override;

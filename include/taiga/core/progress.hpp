@@ -9,7 +9,8 @@
 
 namespace taiga {
 
-/// "label  120/3000 scans   4%  9.8 scans/s  elapsed 0:12  remaining 4:54"
+/// "label  120/3000 scans   4%  9.8 scans/s  elapsed 0:12  remaining 4:54"; with total 0
+/// (unknown) "label  120 scans  9.8 scans/s  elapsed 0:12".
 std::string formatProgressLine(const std::string& label, std::size_t done, std::size_t total,
                                const std::string& unit, double elapsed_s);
 

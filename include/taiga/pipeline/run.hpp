@@ -1,0 +1,50 @@
+#pragma once
+// `taiga run`: the odometry over a whole recording, with the outputs of DESIGN.md section 4:
+//   trajectory.tum       one pose per scan (T_world_body at the scan's end)
+//   trajectory_imu.tum   IMU-rate poses (propagated between scans, as published live)
+//   keyframes.tum        the keyframe poses
+//   map.las              every keyframe's full deskewed scan in the world frame (GPS time =
+//                        point time, point source ID = keyframe number), streamed as keyframes
+//                        are made, so memory stays flat; map.ply on request
+//   timing.csv           per scan: t_s and the stage durations in ms (docs/formats.md)
+//   scans.csv            per scan: registration diagnostics (fitness, iterations, lidar factor)
+//   summary.json         counts, per-scan time statistics, real-time factor, peak memory
+
+#include <filesystem>
+#include <string>
+
+#include "taiga/core/system_config.hpp"
+
+namespace taiga::pipeline {
+
+struct RunOptions {
+  std::filesystem::path out_dir;
+  bool write_ply = false;     ///< also map.ply (holds the map in memory until the end)
+  double map_voxel_m = 0.0;   ///< > 0: the map is decimated to one point per voxel per keyframe
+  bool realtime = false;      ///< pace the recording at sensor rate
+  bool show_progress = true;  ///< a progress line on a terminal
+};
+
+struct RunSummary {
+  std::size_t scans = 0;            ///< scans read
+  std::size_t scans_processed = 0;  ///< scans that gave a state
+  std::size_t imu_samples = 0;
+  std::size_t keyframes = 0;
+  std::size_t lidar_rejected = 0;
+  std::size_t lidar_inflated = 0;
+  std::size_t map_points = 0;
+  double duration_s = 0.0;  ///< recording time covered by the states
+  double path_length_m = 0.0;
+  double mean_ms = 0.0, median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;
+  double wall_time_s = 0.0;
+  double realtime_factor = 0.0;  ///< recording duration / wall time (> 1: faster than the sensor)
+  double peak_memory_mb = 0.0;
+  std::string initialization;
+};
+
+/// Runs the odometry over `recording` and writes the outputs into options.out_dir (created).
+/// Throws InputError for unreadable input or an unwritable output directory.
+RunSummary runOdometry(const std::filesystem::path& recording, const SystemConfig& config,
+                       const RunOptions& options);
+
+}  // namespace taiga::pipeline

@@ -1,0 +1,379 @@
+#include "taiga/pipeline/lidar_inertial_odometry.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "taiga/core/log.hpp"
+#include "taiga/imu/gravity_alignment.hpp"
+#include "taiga/imu/initialization.hpp"
+#include "taiga/imu/propagation.hpp"
+#include "taiga/preprocess/crop.hpp"
+#include "taiga/preprocess/deskew.hpp"
+#include "taiga/preprocess/voxel_filter.hpp"
+#include "taiga/registration/kdtree.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+/// IMU readings needed before the first scan is used, s.
+constexpr double kInitializationWindow_s = 0.5;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+lie::SE3 poseOf(const imu::NavState& state) { return lie::SE3(state.R_world_body, state.p_world); }
+
+}  // namespace
+
+const char* lidarFactorName(LidarFactor factor) {
+  switch (factor) {
+    case LidarFactor::kFirstScan:
+      return "first_scan";
+    case LidarFactor::kUsed:
+      return "used";
+    case LidarFactor::kInflated:
+      return "inflated";
+    case LidarFactor::kRejected:
+      return "rejected";
+  }
+  return "?";
+}
+
+LidarInertialOdometry::LidarInertialOdometry(const OdometryConfig& config, const RigConfig& rig)
+    : config_(config),
+      rig_(rig),
+      gravity_world_(0.0, 0.0, -config.imu.gravity_mps2),
+      smoother_({.gravity_world = gravity_world_, .window_states = config.window_states}),
+      local_map_(config.ndt_resolution_m, config.local_map_keyframes),
+      levelled_(config.gravity_alignment_s <= 0.0) {}
+
+LidarInertialOdometry::~LidarInertialOdometry() = default;
+
+imu::ImuNoise LidarInertialOdometry::imuNoise() const {
+  return {config_.imu.accel_noise_density, config_.imu.gyro_noise_density,
+          config_.imu.accel_bias_random_walk, config_.imu.gyro_bias_random_walk};
+}
+
+void LidarInertialOdometry::addImu(const ImuSample& sample) {
+  // Readings in the body frame; the lever arm of an IMU away from the body origin is not modelled
+  // (the body frame should be the IMU frame, the default).
+  ImuSample in_body = sample;
+  const lie::SO3& R_body_imu = rig_.T_body_imu.rotation();
+  in_body.acceleration_imu_mps2 = R_body_imu * sample.acceleration_imu_mps2;
+  in_body.angular_velocity_imu_radps = R_body_imu * sample.angular_velocity_imu_radps;
+  if (!imu_.add(in_body))
+    logger().debug("IMU reading at {:.6f} s is not after the previous one; ignored", sample.t_s);
+}
+
+PointCloud LidarInertialOdometry::deskewScan(const io::Scan& scan, const imu::NavState& state_prev,
+                                             double t_prev, const imu::ImuBias& bias,
+                                             std::vector<StampedPose>* imu_rate_poses) {
+  const double t_from = std::min(t_prev, scan.t_start_s);
+  const std::vector<ImuSample> readings = imu_.between(t_from, scan.t_end_s);
+  const auto states =
+      imu::propagateThrough(state_prev, t_prev, scan.t_end_s, readings, bias, gravity_world_);
+  if (imu_rate_poses) {
+    for (std::size_t k = 1; k < states.size(); ++k)
+      imu_rate_poses->push_back({states[k].t_s, poseOf(states[k].state)});
+  }
+  const PointCloud in_range =
+      preprocess::keepRange(scan.cloud_in_lidar, config_.min_range_m, config_.max_range_m);
+  return preprocess::deskew(in_range, rig_.T_body_lidar, imu::toTrajectory(states), scan.t_end_s)
+      .cloud_in_body;
+}
+
+void LidarInertialOdometry::initialize(const io::Scan& first, const io::Scan& second) {
+  const imu::InitialState init =
+      imu::initializeFromImu(imu_.all(), {.gravity_mps2 = config_.imu.gravity_mps2});
+  initialization_note_ = init.description;
+  logger().info("IMU initialization, {}", init.description);
+
+  // The sweep of the first scan smears by the distance travelled during it (0.13 m at a walking
+  // pace), and the local map starts from it: deskewing it needs the velocity, which the IMU alone
+  // does not give while moving. Registering the second scan to the first gives it (the mean
+  // velocity between the scans' ends); two rounds, the second with both scans deskewed with it.
+  imu::NavState at_first_start = init.state;
+  at_first_start.p_world.setZero();
+  at_first_start.v_world.setZero();
+  const double dt = second.t_end_s - first.t_end_s;
+  imu::NavState at_first_end;
+  PointCloud first_in_body;
+  for (int round = 0; round < 2; ++round) {
+    const std::vector<ImuSample> readings = imu_.between(first.t_start_s, second.t_end_s);
+    const auto over_first = imu::propagateThrough(at_first_start, first.t_start_s, first.t_end_s,
+                                                  readings, init.bias, gravity_world_);
+    at_first_end = over_first.back().state;
+    first_in_body =
+        preprocess::deskew(
+            preprocess::keepRange(first.cloud_in_lidar, config_.min_range_m, config_.max_range_m),
+            rig_.T_body_lidar, imu::toTrajectory(over_first), first.t_end_s)
+            .cloud_in_body;
+    const auto over_second = imu::propagateThrough(at_first_end, first.t_end_s, second.t_end_s,
+                                                   readings, init.bias, gravity_world_);
+    const PointCloud second_in_body =
+        preprocess::deskew(
+            preprocess::keepRange(second.cloud_in_lidar, config_.min_range_m, config_.max_range_m),
+            rig_.T_body_lidar, imu::toTrajectory(over_second), second.t_end_s)
+            .cloud_in_body;
+    std::vector<Eigen::Vector3d> target =
+        preprocess::voxelFilter(first_in_body, config_.local_map_voxel_m).positions;
+    const lie::SE3 T_world_first = poseOf(at_first_end);
+    for (Eigen::Vector3d& p : target) p = T_world_first * p;
+    registration::NdtConfig ndt;
+    ndt.resolution_m = config_.ndt_resolution_m;
+    const registration::RegistrationResult r = registration::alignNdt(
+        preprocess::voxelFilter(second_in_body, config_.voxel_size_m).positions,
+        registration::NdtTarget::fromPoints(target, config_.ndt_resolution_m),
+        poseOf(over_second.back().state), ndt);
+    if (r.num_inliers == 0 || !std::isfinite(r.hessian_condition)) {
+      logger().warn(
+          "initial velocity: the second scan did not register to the first ({}); starting from "
+          "rest",
+          r.reason);
+      break;
+    }
+    const Eigen::Vector3d v_world =
+        (r.T_target_source.translation() - T_world_first.translation()) / dt;
+    // The first sweep's start velocity, from the mean velocity between the scan ends.
+    at_first_start.v_world = v_world;
+  }
+  logger().info("initial velocity {:.2f} m/s from the first two scans",
+                at_first_start.v_world.norm());
+  initialization_note_ += fmt::format("; initial speed {:.2f} m/s from the first two scans",
+                                      at_first_start.v_world.norm());
+
+  backend::StateEstimate estimate;
+  estimate.t_s = first.t_end_s;
+  estimate.state = at_first_end;
+  estimate.bias = init.bias;
+  estimate.covariance = init.covariance;
+  estimate.covariance.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() * 0.2 * 0.2;
+  smoother_.initialize(estimate);
+
+  ScanOutcome outcome;
+  outcome.scan_index = first.index;
+  outcome.t_s = first.t_end_s;
+  outcome.T_world_body = poseOf(estimate.state);
+  outcome.v_world = estimate.state.v_world;
+  outcome.bias = estimate.bias;
+  outcome.lidar = LidarFactor::kFirstScan;
+  if (!levelled_) collectForAlignment(outcome, nullptr);
+  maybeAddKeyframe(outcome, first_in_body);
+  first_outcome_ = std::move(outcome);
+}
+
+std::optional<ScanOutcome> LidarInertialOdometry::addScan(const io::Scan& scan) {
+  if (!initialized()) {
+    if (imu_.empty() || imu_.lastTime() - imu_.firstTime() < kInitializationWindow_s) {
+      logger().debug(
+          "scan {} at {:.3f} s skipped: waiting for {:.1f} s of IMU readings to initialize",
+          scan.index, scan.t_end_s, kInitializationWindow_s);
+      return std::nullopt;
+    }
+    if (!first_scan_) {
+      first_scan_ = scan;  // initialization needs the next scan too
+      return std::nullopt;
+    }
+    initialize(*first_scan_, scan);
+    first_scan_.reset();
+  }
+  const auto start = Clock::now();
+  const backend::StateEstimate previous = smoother_.latest();
+  ScanOutcome outcome;
+  outcome.scan_index = scan.index;
+  outcome.t_s = scan.t_end_s;
+  if (scan.t_end_s <= previous.t_s) {
+    logger().warn("scan {} ends at {:.6f} s, not after the previous state at {:.6f} s; skipped",
+                  scan.index, scan.t_end_s, previous.t_s);
+    return std::nullopt;
+  }
+
+  // 1. Preintegrate and predict.
+  const imu::Preintegrator preintegrated =
+      imu_.preintegrate(previous.t_s, scan.t_end_s, previous.bias, imuNoise());
+  const lie::SE3 predicted =
+      poseOf(preintegrated.predict(previous.state, previous.bias, gravity_world_));
+
+  // 2. Deskew into the body frame at the scan's end.
+  const PointCloud cloud_in_body =
+      deskewScan(scan, previous.state, previous.t_s, previous.bias, &outcome.imu_rate_poses);
+  outcome.timing.deskew_ms = msSince(start);
+
+  // 3. Voxel filter.
+  auto stage = Clock::now();
+  const PointCloud source_cloud = preprocess::voxelFilter(cloud_in_body, config_.voxel_size_m);
+  outcome.source_points = source_cloud.size();
+  outcome.timing.filter_ms = msSince(stage);
+
+  // 4. Register to the local map.
+  stage = Clock::now();
+  outcome.registration = registerToMap(source_cloud.positions, predicted);
+  outcome.timing.registration_ms = msSince(stage);
+
+  // 5. Judge it; 6. optimize the odometry graph.
+  stage = Clock::now();
+  const std::optional<backend::PoseMeasurement> measurement = judge(outcome, predicted);
+  const backend::StateEstimate estimate =
+      smoother_.addState(scan.t_end_s, preintegrated, measurement);
+  imu_.dropBefore(estimate.t_s);
+  outcome.T_world_body = poseOf(estimate.state);
+  outcome.v_world = estimate.state.v_world;
+  outcome.bias = estimate.bias;
+  if (!levelled_) {
+    collectForAlignment(outcome, &preintegrated);
+    if (alignment_times_.back() - alignment_times_.front() >= config_.gravity_alignment_s)
+      levelWorld(outcome);
+  }
+  outcome.timing.optimization_ms = msSince(stage);
+
+  // 7. Keyframe.
+  stage = Clock::now();
+  maybeAddKeyframe(outcome, cloud_in_body);
+  outcome.timing.map_ms = msSince(stage);
+  outcome.timing.total_ms = msSince(start);
+  return outcome;
+}
+
+registration::RegistrationResult LidarInertialOdometry::registerToMap(
+    const std::vector<Eigen::Vector3d>& source, const lie::SE3& guess_T_world_body) {
+  registration::NdtConfig ndt;
+  ndt.resolution_m = config_.ndt_resolution_m;
+  registration::RegistrationResult result;
+  if (config_.method == "gicp") {
+    result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),
+                                     guess_T_world_body, {});
+  } else if (config_.method == "d2d") {
+    result = registration::alignD2dNdt(source, local_map_.ndtTarget(), guess_T_world_body, ndt);
+  } else {
+    result = registration::alignNdt(source, local_map_.ndtTarget(), guess_T_world_body, ndt);
+  }
+  // Points farther than a few NDT cells from the map are new ground, not misalignment.
+  result.fitness_m2 = registration::fitnessScore(
+      source, local_map_.kdTree(), result.T_target_source, 2.0 * config_.ndt_resolution_m);
+  return result;
+}
+
+std::optional<backend::PoseMeasurement> LidarInertialOdometry::judge(
+    ScanOutcome& outcome, const lie::SE3& predicted) const {
+  const registration::RegistrationResult& r = outcome.registration;
+  const lie::Vector6 jump = (predicted.inverse() * r.T_target_source).Log();
+  const double jump_m = jump.head<3>().norm(), jump_deg = jump.tail<3>().norm() / kDegToRad;
+  std::string rejected;
+  if (r.iterations == 0 || r.num_inliers == 0 || !std::isfinite(r.hessian_condition)) {
+    rejected = "registration failed: " + r.reason;
+  } else if (!std::isfinite(r.fitness_m2) || r.fitness_m2 > config_.max_fitness_m2) {
+    rejected = fmt::format("fitness {:.3f} m^2 above {:.3f}", r.fitness_m2, config_.max_fitness_m2);
+  } else if (jump_m > config_.max_jump_m || jump_deg > config_.max_jump_deg) {
+    rejected = fmt::format("{:.3f} m / {:.2f} deg from the IMU prediction", jump_m, jump_deg);
+  }
+  if (!rejected.empty()) {
+    outcome.lidar = LidarFactor::kRejected;
+    outcome.lidar_note = rejected;
+    return std::nullopt;
+  }
+  // Thesis Eq. 36, as we read it: sigma_sm while the fitness is below tau_fs, growing with the
+  // fitness ratio to the power theta_smsc above it (docs/odometry.md).
+  const double ratio = std::max(1.0, r.fitness_m2 / config_.fitness_threshold_m2);
+  double sigma = config_.lidar_sigma * std::pow(ratio, config_.fitness_sigma_exponent);
+  outcome.lidar = LidarFactor::kUsed;
+  if (!r.converged || r.hessian_condition > config_.degenerate_condition) {
+    sigma *= 10.0;
+    outcome.lidar = LidarFactor::kInflated;
+    outcome.lidar_note =
+        !r.converged ? "registration hit its iteration limit"
+                     : fmt::format("degenerate: Hessian condition {:.3g}", r.hessian_condition);
+  }
+  return backend::PoseMeasurement{r.T_target_source, lie::Matrix6::Identity() * sigma * sigma};
+}
+
+void LidarInertialOdometry::collectForAlignment(const ScanOutcome& outcome,
+                                                const imu::Preintegrator* increment) {
+  // The lidar's own pose where registration worked: the alignment must not see the IMU's
+  // (wrongly levelled) prediction; the fused pose otherwise.
+  const bool lidar_pose =
+      outcome.lidar == LidarFactor::kUsed || outcome.lidar == LidarFactor::kInflated;
+  alignment_times_.push_back(outcome.t_s);
+  alignment_poses_.push_back(lidar_pose ? outcome.registration.T_target_source
+                                        : outcome.T_world_body);
+  if (increment) alignment_increments_.push_back(*increment);
+}
+
+void LidarInertialOdometry::levelWorld(ScanOutcome& outcome) {
+  const imu::GravityAlignment a =
+      imu::alignGravity(alignment_poses_, alignment_increments_, config_.imu.gravity_mps2);
+  alignment_times_.clear();
+  alignment_poses_.clear();
+  alignment_increments_.clear();
+  // A free estimate of |g| far from gravity means the poses and the IMU disagree (bad
+  // registrations, a wrong time offset): keep the IMU attitude rather than trust it.
+  if (std::abs(a.estimated_magnitude_mps2 - config_.imu.gravity_mps2) >
+      0.05 * config_.imu.gravity_mps2) {
+    logger().warn(
+        "gravity alignment over the first {:.1f} s found |g| = {:.2f} m/s^2; keeping the IMU's "
+        "attitude",
+        config_.gravity_alignment_s, a.estimated_magnitude_mps2);
+    levelled_ = true;
+    return;
+  }
+  const lie::SE3 T_new_old(a.R_levelled_world, Eigen::Vector3d::Zero());
+  const backend::StateEstimate current = smoother_.latest();
+  backend::StateEstimate levelled = current;
+  levelled.state.R_world_body = a.R_levelled_world * current.state.R_world_body;
+  levelled.state.p_world = a.R_levelled_world * current.state.p_world;
+  levelled.state.v_world = a.R_levelled_world * a.v_world.back();
+  // Tilt and velocity now come from the alignment; position and heading keep fixing the gauge.
+  levelled.covariance = current.covariance;
+  levelled.covariance.block<15, 6>(0, 0).setZero();
+  levelled.covariance.block<6, 15>(0, 0).setZero();
+  levelled.covariance.block<3, 9>(6, 6).setZero();
+  levelled.covariance.block<9, 3>(6, 6).setZero();
+  const double tilt_sigma = 0.3 * kDegToRad;
+  levelled.covariance.diagonal().head<9>() << Eigen::Vector3d::Constant(1e-6),
+      tilt_sigma * tilt_sigma, tilt_sigma * tilt_sigma, 1e-6,
+      Eigen::Vector3d::Constant(0.05 * 0.05);
+  smoother_.initialize(levelled);
+  // The keyframes so far were deskewed with the velocity still unknown (zero at the start): the
+  // local map starts over from this scan, deskewed with the velocity the odometry has found.
+  local_map_ = LocalMap(config_.ndt_resolution_m, config_.local_map_keyframes);
+  last_keyframe_T_world_body_.reset();
+  outcome.T_world_body = poseOf(levelled.state);
+  outcome.v_world = levelled.state.v_world;
+  for (StampedPose& p : outcome.imu_rate_poses) p.pose = T_new_old * p.pose;
+  outcome.world_correction = T_new_old;
+  levelled_ = true;
+  const double tilt_deg =
+      std::acos(std::clamp(a.gravity_world.normalized().z() * -1.0, -1.0, 1.0)) / kDegToRad;
+  logger().info(
+      "gravity alignment: the initial attitude was off by {:.2f} deg of tilt; world frame levelled "
+      "(|g| estimated {:.3f} m/s^2)",
+      tilt_deg, a.estimated_magnitude_mps2);
+  initialization_note_ +=
+      fmt::format("; levelled after {:.1f} s by {:.2f} deg", config_.gravity_alignment_s, tilt_deg);
+}
+
+void LidarInertialOdometry::maybeAddKeyframe(ScanOutcome& outcome,
+                                             const PointCloud& cloud_in_body) {
+  if (last_keyframe_T_world_body_) {
+    const lie::Vector6 moved =
+        (last_keyframe_T_world_body_->inverse() * outcome.T_world_body).Log();
+    const double travelled_m =
+        (outcome.T_world_body.translation() - last_keyframe_T_world_body_->translation()).norm() +
+        config_.keyframe_rotation_weight_m_per_rad * moved.tail<3>().norm();
+    if (travelled_m < config_.keyframe_distance_m) return;
+  }
+  outcome.keyframe = true;
+  last_keyframe_T_world_body_ = outcome.T_world_body;
+  std::vector<Eigen::Vector3d> points_in_world =
+      preprocess::voxelFilter(cloud_in_body, config_.local_map_voxel_m).positions;
+  for (Eigen::Vector3d& p : points_in_world) p = outcome.T_world_body * p;
+  local_map_.addKeyframe(std::move(points_in_world));
+  outcome.keyframe_cloud_in_body = cloud_in_body;
+}
+
+}  // namespace taiga::pipeline

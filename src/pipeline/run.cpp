@@ -1,0 +1,218 @@
+#include "taiga/pipeline/run.hpp"
+
+#include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <thread>
+#include <vector>
+
+#include "taiga/core/errors.hpp"
+#include "taiga/core/log.hpp"
+#include "taiga/core/progress.hpp"
+#include "taiga/io/cloud_files.hpp"
+#include "taiga/io/las_writer.hpp"
+#include "taiga/io/trajectory_io.hpp"
+#include "taiga/pipeline/lidar_inertial_odometry.hpp"
+#include "taiga/preprocess/voxel_filter.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::ofstream openOutput(const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!out) throw InputError(fmt::format("{}: cannot write", path.string()));
+  return out;
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double rank = p * static_cast<double>(values.size() - 1);
+  const auto lo = static_cast<std::size_t>(rank);
+  const std::size_t hi = std::min(lo + 1, values.size() - 1);
+  return values[lo] + (rank - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
+double peakMemoryMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+/// Appends a pose to a trajectory unless it is not after the last one (IMU-rate poses repeat the
+/// state times at scan boundaries).
+void appendIfLater(Trajectory& trajectory, double t_s, const lie::SE3& pose) {
+  if (trajectory.empty() || t_s > trajectory.endTime()) trajectory.append(t_s, pose);
+}
+
+Trajectory transformed(const Trajectory& trajectory, const lie::SE3& T_new_old) {
+  Trajectory out;
+  for (const StampedPose& p : trajectory) out.append(p.t_s, T_new_old * p.pose);
+  return out;
+}
+
+void writeSummary(const std::filesystem::path& path, const RunSummary& s,
+                  const std::filesystem::path& recording) {
+  const nlohmann::ordered_json j = {
+      {"recording", recording.string()},
+      {"scans", s.scans},
+      {"scans_processed", s.scans_processed},
+      {"imu_samples", s.imu_samples},
+      {"keyframes", s.keyframes},
+      {"loop_closures", 0},
+      {"registration_failures", s.lidar_rejected},
+      {"lidar_factors_inflated", s.lidar_inflated},
+      {"map_points", s.map_points},
+      {"duration_s", s.duration_s},
+      {"path_length_m", s.path_length_m},
+      {"time_per_scan_ms",
+       {{"mean", s.mean_ms}, {"p50", s.median_ms}, {"p95", s.p95_ms}, {"max", s.max_ms}}},
+      {"wall_time_s", s.wall_time_s},
+      {"realtime_factor", s.realtime_factor},
+      {"peak_memory_mb", s.peak_memory_mb},
+      {"initialization", s.initialization},
+  };
+  openOutput(path) << j.dump(2) << "\n";
+}
+
+}  // namespace
+
+RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& config,
+                       const RunOptions& options) {
+  std::error_code ec;
+  std::filesystem::create_directories(options.out_dir, ec);
+  if (ec)
+    throw InputError(fmt::format("{}: cannot create the output directory: {}",
+                                 options.out_dir.string(), ec.message()));
+
+  io::Recording recording = io::openRecording(recording_path, config.recording, config.rig);
+  LidarInertialOdometry odometry(config.odometry, config.rig);
+
+  std::ofstream timing = openOutput(options.out_dir / "timing.csv");
+  timing << "t_s,scan,deskew_ms,filter_ms,registration_ms,optimization_ms,map_ms,total_ms\n";
+  std::ofstream scans = openOutput(options.out_dir / "scans.csv");
+  scans << "t_s,scan,lidar_factor,fitness_m2,iterations,converged,inliers,hessian_condition,source_"
+           "points,keyframe,note\n";
+  io::LasWriter map(options.out_dir / "map.las");
+  PointCloud map_for_ply;
+
+  Trajectory trajectory, trajectory_imu, keyframes;
+  // Keyframe clouds wait here (world frame) until the world frame is levelled, then stream out.
+  std::vector<PointCloud> pending_map;
+  auto emitMap = [&](const PointCloud& cloud_in_world, std::size_t keyframe) {
+    map.append(cloud_in_world, static_cast<std::uint16_t>(keyframe % 65536));
+    if (options.write_ply) map_for_ply.append(cloud_in_world);
+  };
+  RunSummary summary;
+  std::vector<double> totals_ms;
+  Progress progress("taiga run", 0, "scans", stderr,
+                    options.show_progress && isatty(fileno(stderr)));
+  const auto wall_start = Clock::now();
+  std::optional<double> first_event_s;
+
+  auto consume = [&](const ScanOutcome& outcome) {
+    ++summary.scans_processed;
+    if (outcome.world_correction) {
+      const lie::SE3& T_new_old = *outcome.world_correction;
+      trajectory = transformed(trajectory, T_new_old);
+      trajectory_imu = transformed(trajectory_imu, T_new_old);
+      keyframes = transformed(keyframes, T_new_old);
+      for (PointCloud& cloud : pending_map)
+        for (Eigen::Vector3d& p : cloud.positions) p = T_new_old * p;
+    }
+    appendIfLater(trajectory, outcome.t_s, outcome.T_world_body);
+    for (const StampedPose& p : outcome.imu_rate_poses)
+      appendIfLater(trajectory_imu, p.t_s, p.pose);
+    appendIfLater(trajectory_imu, outcome.t_s, outcome.T_world_body);
+    summary.lidar_rejected += outcome.lidar == LidarFactor::kRejected;
+    summary.lidar_inflated += outcome.lidar == LidarFactor::kInflated;
+    totals_ms.push_back(outcome.timing.total_ms);
+    const ScanTiming& t = outcome.timing;
+    timing << fmt::format("{:.6f},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n", outcome.t_s,
+                          outcome.scan_index, t.deskew_ms, t.filter_ms, t.registration_ms,
+                          t.optimization_ms, t.map_ms, t.total_ms);
+    const registration::RegistrationResult& r = outcome.registration;
+    scans << fmt::format("{:.6f},{},{},{:.5f},{},{},{},{:.4g},{},{},\"{}\"\n", outcome.t_s,
+                         outcome.scan_index, lidarFactorName(outcome.lidar), r.fitness_m2,
+                         r.iterations, r.converged ? 1 : 0, r.num_inliers, r.hessian_condition,
+                         outcome.source_points, outcome.keyframe ? 1 : 0, outcome.lidar_note);
+    if (outcome.keyframe_cloud_in_body) {
+      appendIfLater(keyframes, outcome.t_s, outcome.T_world_body);
+      PointCloud cloud =
+          options.map_voxel_m > 0.0
+              ? preprocess::voxelFilter(*outcome.keyframe_cloud_in_body, options.map_voxel_m)
+              : *outcome.keyframe_cloud_in_body;
+      for (Eigen::Vector3d& p : cloud.positions) p = outcome.T_world_body * p;
+      pending_map.push_back(std::move(cloud));
+      ++summary.keyframes;
+    }
+  };
+  std::size_t stream = 0;
+  while (std::optional<io::RecordingEvent> event = recording.next(&stream)) {
+    const double t_event = io::eventTime(*event);
+    if (!first_event_s) first_event_s = t_event;
+    if (options.realtime) {
+      std::this_thread::sleep_until(wall_start +
+                                    std::chrono::duration<double>(t_event - *first_event_s));
+    }
+    if (const auto* imu = std::get_if<ImuSample>(&*event)) {
+      odometry.addImu(*imu);
+      ++summary.imu_samples;
+      continue;
+    }
+    const auto* scan = std::get_if<io::Scan>(&*event);
+    if (!scan) continue;  // GNSS fixes: used by georeferencing, not by the odometry
+    ++summary.scans;
+    const std::optional<ScanOutcome> outcome = odometry.addScan(*scan);
+    progress.update(summary.scans);
+    if (std::optional<ScanOutcome> first = odometry.takeFirstOutcome()) consume(*first);
+    if (outcome) consume(*outcome);
+    if (odometry.levelled()) {
+      for (std::size_t k = 0; k < pending_map.size(); ++k)
+        emitMap(pending_map[k], summary.keyframes - pending_map.size() + k);
+      pending_map.clear();
+    }
+  }
+  for (std::size_t k = 0; k < pending_map.size(); ++k)
+    emitMap(pending_map[k], summary.keyframes - pending_map.size() + k);
+  progress.finish();
+  map.close();
+  summary.map_points = map.pointCount();
+  summary.wall_time_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+
+  if (trajectory.empty()) {
+    throw InputError(
+        fmt::format("{}: no scan could be processed ({} scans, {} IMU samples): the odometry needs "
+                    "scans with per-point times and at least 0.5 s of IMU readings before them",
+                    recording_path.string(), summary.scans, summary.imu_samples));
+  }
+  io::writeTum(options.out_dir / "trajectory.tum", trajectory);
+  io::writeTum(options.out_dir / "trajectory_imu.tum", trajectory_imu);
+  io::writeTum(options.out_dir / "keyframes.tum", keyframes);
+  if (options.write_ply) io::writePly(options.out_dir / "map.ply", map_for_ply);
+
+  summary.duration_s = trajectory.endTime() - trajectory.startTime();
+  summary.path_length_m = trajectory.pathLength();
+  summary.mean_ms = totals_ms.empty() ? 0.0
+                                      : std::accumulate(totals_ms.begin(), totals_ms.end(), 0.0) /
+                                            totals_ms.size();
+  summary.median_ms = percentile(totals_ms, 0.5);
+  summary.p95_ms = percentile(totals_ms, 0.95);
+  summary.max_ms = totals_ms.empty() ? 0.0 : *std::max_element(totals_ms.begin(), totals_ms.end());
+  summary.realtime_factor =
+      summary.wall_time_s > 0.0 ? summary.duration_s / summary.wall_time_s : 0.0;
+  summary.peak_memory_mb = peakMemoryMb();
+  summary.initialization = odometry.initializationNote();
+  writeSummary(options.out_dir / "summary.json", summary, recording_path);
+  return summary;
+}
+
+}  // namespace taiga::pipeline
