@@ -40,6 +40,12 @@ std::optional<std::string> inputProblem(std::span<const Eigen::Vector3d> points,
                                         const std::string& what, std::size_t min_points,
                                         double planar_ratio) {
   if (points.empty()) return what + " cloud is empty";
+  std::size_t non_finite = 0;
+  for (const auto& p : points) non_finite += p.allFinite() ? 0 : 1;
+  if (non_finite > 0) {
+    return what + " cloud has " + std::to_string(non_finite) +
+           " non-finite points (NaN or infinite coordinates); remove them first";
+  }
   if (points.size() < min_points) {
     return what + " cloud has too few points (" + std::to_string(points.size()) + " < " +
            std::to_string(min_points) + ")";

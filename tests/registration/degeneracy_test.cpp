@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -74,6 +75,11 @@ TEST(Degeneracy, PlanarityRatio) {
   EXPECT_TRUE(inputProblem(plane, "source", 10, 1e-6).has_value());
   plane.emplace_back(0.0, 0.0, 5.0);
   EXPECT_GT(planarityRatio(plane), 1e-4);
+  EXPECT_FALSE(inputProblem(plane, "source", 10, 1e-6).has_value());
+  plane.emplace_back(std::nan(""), 0.0, 0.0);
+  const auto problem = inputProblem(plane, "source", 10, 1e-6);
+  ASSERT_TRUE(problem.has_value());
+  EXPECT_NE(problem->find("1 non-finite points"), std::string::npos) << *problem;
 }
 
 }  // namespace

@@ -12,8 +12,9 @@ namespace taiga::registration {
 /// line), about 1 for a blob. 0 for fewer than 3 points.
 double planarityRatio(std::span<const Eigen::Vector3d> points);
 
-/// A reason string when `points` (named `what`, e.g. "source") cannot be registered: fewer than
-/// `min_points` points, or planar (planarityRatio below `planar_ratio`). Empty optional otherwise.
+/// A reason string when `points` (named `what`, e.g. "source") cannot be registered: empty,
+/// containing non-finite points, fewer than `min_points` points, or planar (planarityRatio below
+/// `planar_ratio`). Empty optional otherwise.
 std::optional<std::string> inputProblem(std::span<const Eigen::Vector3d> points,
                                         const std::string& what, std::size_t min_points,
                                         double planar_ratio);

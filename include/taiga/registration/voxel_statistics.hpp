@@ -37,8 +37,9 @@ class VoxelStatistics {
   double resolution_m() const { return resolution_m_; }
   /// Adds points (non-finite points and points beyond the voxel range are skipped and counted).
   void add(std::span<const Eigen::Vector3d> points);
-  /// Removes points that were added before (the same coordinates). Removing a point that is not
-  /// in the statistics throws std::logic_error, leaving the statistics partially updated.
+  /// Removes points that were added before (the same coordinates). A point whose cell is empty
+  /// throws std::logic_error (the statistics are then partially updated); a point that was never
+  /// added but falls into an occupied cell cannot be detected and corrupts that cell's sums.
   void remove(std::span<const Eigen::Vector3d> points);
   void clear() { cells_.clear(); }
 
