@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 
 #include "taiga/core/errors.hpp"
@@ -20,6 +22,8 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 constexpr int kMaxSubRays = 8;
+/// Range of a ray that hit nothing.
+constexpr double kNoHit = std::numeric_limits<double>::infinity();
 /// Reflectivity of the target that reaches max_range_m at normal incidence.
 constexpr double kReferenceReflectivity = 0.8;
 
@@ -105,46 +109,107 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   const double center_weight = k_rays == 1 ? 1.0 : 0.4;
   const double ring_weight = k_rays == 1 ? 0.0 : 0.6 / (k_rays - 1);
 
+  // Pass 1: the centre ray of every pixel, each column from the true pose at its firing time.
+  struct Column {
+    Eigen::Matrix3d R_world_lidar;
+    Eigen::Vector3d origin_lidar, origin_world;
+  };
+  std::vector<Column> columns(cols);
+  std::vector<SubHit> centers(pixels.size(), SubHit{kNoHit, 0.0, 0.0});
+  std::vector<std::uint8_t> solid(pixels.size(), 0);
+  auto direction = [&](int col, int row) {
+    const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
+    const double az = theta_e - geometry_.beam_azimuth_deg[row] * kDeg;
+    const double alt = geometry_.beam_altitude_deg[row] * kDeg;
+    return Eigen::Vector3d(std::cos(az) * std::cos(alt), std::sin(az) * std::cos(alt),
+                           std::sin(alt));
+  };
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>& range) {
+        std::vector<Eigen::Vector3d> dirs(rows);
+        std::vector<std::optional<RayHit>> column_hits;
+        for (int col = range.begin(); col != range.end(); ++col) {
+          const double t = t_start_s + col * dt_column;
+          const lie::SE3 T_world_lidar =
+              motion.at(t).T_world_body * T_body_sensor * geometry_.T_sensor_lidar;
+          const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
+          Column& c = columns[col];
+          c.R_world_lidar = T_world_lidar.rotation().matrix();
+          c.origin_lidar =
+              Eigen::Vector3d(geometry_.lidar_origin_to_beam_origin_m * std::cos(theta_e),
+                              geometry_.lidar_origin_to_beam_origin_m * std::sin(theta_e),
+                              geometry_.beam_origin_z_m);
+          c.origin_world = T_world_lidar * c.origin_lidar;
+          for (int row = 0; row < rows; ++row) dirs[row] = c.R_world_lidar * direction(col, row);
+          scene.castRays(c.origin_world, dirs, params_.max_range_m * 1.2,
+                         column_hits);  // packets of 16
+          for (int row = 0; row < rows; ++row) {
+            const auto& hit = column_hits[row];
+            if (!hit) continue;
+            const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(dirs[row])));
+            const std::size_t pixel = static_cast<std::size_t>(col) * rows + row;
+            centers[pixel] = {hit->range_m, 1.0, reflectivity(hit->material) * cos_inc};
+            solid[pixel] = hit->material != Material::kFoliage ? 1 : 0;
+          }
+        }
+      });
+
+  // Pass 2: where the centre ranges of neighbouring pixels jump (an edge), the beam footprint
+  // straddles several surfaces: cast the sub-rays of the ring and mix. Elsewhere the footprint
+  // lies on one surface and the centre ray stands for it.
+  auto rangeAt = [&](int col, int row) {
+    return centers[static_cast<std::size_t>((col + cols) % cols) * rows + row].range_m;
+  };
+  // Only the azimuth neighbours are compared: they are one footprint apart (0.35 deg at 1024
+  // columns), while the rows are about two footprints apart (0.7 deg), too far to tell. Only
+  // edges whose nearer side is solid (stems, branches, rocks, logs, the ground) get sub-rays:
+  // foliage is clutter at the footprint's scale anyway, and sub-rays there would triple the cost.
+  auto solidAt = [&](int col, int row) {
+    return solid[static_cast<std::size_t>((col + cols) % cols) * rows + row] != 0;
+  };
+  auto isEdge = [&](int col, int row) {
+    const double r = rangeAt(col, row);
+    for (const int nb : {col - 1, col + 1}) {
+      const double q = rangeAt(nb, row);
+      if (q == r) continue;
+      const bool near_is_self = r < q;
+      if (!(near_is_self ? solidAt(col, row) : solidAt(nb, row))) continue;
+      if (q == kNoHit || r == kNoHit || std::abs(q - r) > 0.15 + 0.01 * std::min(r, q)) return true;
+    }
+    return false;
+  };
   tbb::parallel_for(tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>&
                                                                   range) {
     std::array<SubHit, kMaxSubRays> hits{};
     for (int col = range.begin(); col != range.end(); ++col) {
-      const double t = t_start_s + col * dt_column;
-      const lie::SE3 T_world_lidar =
-          motion.at(t).T_world_body * T_body_sensor * geometry_.T_sensor_lidar;
-      const Eigen::Matrix3d R = T_world_lidar.rotation().matrix();
-      const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
-      const Eigen::Vector3d origin_lidar(
-          geometry_.lidar_origin_to_beam_origin_m * std::cos(theta_e),
-          geometry_.lidar_origin_to_beam_origin_m * std::sin(theta_e), geometry_.beam_origin_z_m);
-      const Eigen::Vector3d origin_world = T_world_lidar * origin_lidar;
+      const Column& c = columns[col];
       for (int row = 0; row < rows; ++row) {
         const std::uint64_t pixel_id = static_cast<std::uint64_t>(col) * rows + row;
-        const double az = theta_e - geometry_.beam_azimuth_deg[row] * kDeg;
-        const double alt = geometry_.beam_altitude_deg[row] * kDeg;
-        const Eigen::Vector3d d_lidar(std::cos(az) * std::cos(alt), std::sin(az) * std::cos(alt),
-                                      std::sin(alt));
-        const Eigen::Vector3d d_world = R * d_lidar;
-        const Eigen::Vector3d e1 =
-            d_world
-                .cross(std::abs(d_world.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
-                                                   : Eigen::Vector3d::UnitX())
-                .normalized();
-        const Eigen::Vector3d e2 = d_world.cross(e1);
-        const double spin = 2.0 * kPi * hashUniform(seed_, index, pixel_id, 101);
+        const Eigen::Vector3d d_lidar = direction(col, row);
+        const SubHit& center = centers[pixel_id];
         int n_hits = 0;
-        for (int k = 0; k < k_rays; ++k) {
-          Eigen::Vector3d dir = d_world;
-          if (k > 0) {
+        if (k_rays > 1 && isEdge(col, row)) {
+          if (center.range_m != kNoHit)
+            hits[n_hits++] = {center.range_m, center_weight, center.reflectivity_eff};
+          const Eigen::Vector3d d_world = c.R_world_lidar * d_lidar;
+          const Eigen::Vector3d e1 =
+              d_world
+                  .cross(std::abs(d_world.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
+                                                     : Eigen::Vector3d::UnitX())
+                  .normalized();
+          const Eigen::Vector3d e2 = d_world.cross(e1);
+          const double spin = 2.0 * kPi * hashUniform(seed_, index, pixel_id, 101);
+          for (int k = 1; k < k_rays; ++k) {
             const double a = spin + 2.0 * kPi * (k - 1) / (k_rays - 1);
-            dir =
+            const Eigen::Vector3d dir =
                 (d_world + std::tan(ring_rad) * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
+            const auto hit = scene.castRay(c.origin_world, dir, 0.0, params_.max_range_m * 1.2);
+            if (!hit) continue;
+            const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(dir)));
+            hits[n_hits++] = {hit->range_m, ring_weight, reflectivity(hit->material) * cos_inc};
           }
-          const auto hit = scene.castRay(origin_world, dir, 0.0, params_.max_range_m * 1.2);
-          if (!hit) continue;
-          const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(dir)));
-          hits[n_hits++] = {hit->range_m, k == 0 ? center_weight : ring_weight,
-                            reflectivity(hit->material) * cos_inc};
+        } else if (center.range_m != kNoHit) {
+          hits[n_hits++] = center;  // weight 1: the whole footprint on one surface
         }
         if (n_hits == 0) continue;
         for (int i = 1; i < n_hits; ++i) {  // insertion sort by range (a handful of entries)
@@ -192,9 +257,9 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
         }
         Pixel& px = pixels[pixel_id];
         px.valid = true;
-        const Eigen::Vector3d p_lidar = origin_lidar + r * d_lidar;
+        const Eigen::Vector3d p_lidar = c.origin_lidar + r * d_lidar;
         px.p_sensor = (geometry_.T_sensor_lidar * p_lidar).cast<float>();
-        px.intensity = static_cast<float>(100.0 * refl);  // reflectivity in percent, as Ouster's
+        px.intensity = static_cast<float>(100.0 * refl);  // reflectivity x cos(incidence), percent
       }
     }
   });

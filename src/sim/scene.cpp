@@ -262,6 +262,54 @@ std::optional<RayHit> Scene::castRay(const Eigen::Vector3d& origin_world,
   return hit;
 }
 
+void Scene::castRays(const Eigen::Vector3d& origin_world,
+                     const std::vector<Eigen::Vector3d>& directions_world, double t_max_m,
+                     std::vector<std::optional<RayHit>>& hits) const {
+  const std::size_t n = directions_world.size();
+  hits.assign(n, std::nullopt);
+  const detail::GeometryBuffers& g = impl_->contents.geometry;
+  for (std::size_t first = 0; first < n; first += 16) {
+    const std::size_t count = std::min<std::size_t>(16, n - first);
+    alignas(64) int valid[16];
+    alignas(64) RTCRayHit16 rh;
+    for (std::size_t i = 0; i < 16; ++i) {
+      const bool active = i < count;
+      valid[i] = active ? -1 : 0;
+      const Eigen::Vector3d& d = directions_world[first + (active ? i : 0)];
+      rh.ray.org_x[i] = static_cast<float>(origin_world.x());
+      rh.ray.org_y[i] = static_cast<float>(origin_world.y());
+      rh.ray.org_z[i] = static_cast<float>(origin_world.z());
+      rh.ray.dir_x[i] = static_cast<float>(d.x());
+      rh.ray.dir_y[i] = static_cast<float>(d.y());
+      rh.ray.dir_z[i] = static_cast<float>(d.z());
+      rh.ray.tnear[i] = 0.0f;
+      rh.ray.tfar[i] = static_cast<float>(t_max_m);
+      rh.ray.time[i] = 0.0f;
+      rh.ray.mask[i] = std::numeric_limits<unsigned>::max();
+      rh.ray.id[i] = 0;
+      rh.ray.flags[i] = 0;
+      rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect16(valid, impl_->scene, &context, &rh);
+    for (std::size_t i = 0; i < count; ++i) {
+      if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+      RayHit hit;
+      hit.range_m = rh.ray.tfar[i];
+      Eigen::Vector3d normal(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]);
+      if (normal.squaredNorm() > 0) normal.normalize();
+      if (normal.dot(directions_world[first + i]) > 0) normal = -normal;
+      hit.normal_world = normal;
+      hit.material = rh.hit.geomID[i] == kTriangleGeometry ? g.tri_materials[rh.hit.primID[i]]
+                                                           : g.curve_materials[rh.hit.primID[i]];
+      hits[first + i] = hit;
+    }
+  }
+}
+
 double Scene::distanceToSurface(const Eigen::Vector3d& p_world, double max_distance_m) const {
   RTCPointQuery query{};
   query.x = static_cast<float>(p_world.x());

@@ -89,6 +89,12 @@ class Scene {
                                 const Eigen::Vector3d& direction_world, double t_min_m,
                                 double t_max_m) const;
 
+  /// Nearest hits of rays that share an origin (e.g. one lidar column), in packets of 16
+  /// (Embree rtcIntersect16): hits[i] for directions[i]. Same results as castRay. Thread-safe.
+  void castRays(const Eigen::Vector3d& origin_world,
+                const std::vector<Eigen::Vector3d>& directions_world, double t_max_m,
+                std::vector<std::optional<RayHit>>& hits) const;
+
   /// Unsigned distance from a point to the nearest scene surface, m, or max_distance_m when
   /// nothing is closer. Curves count as cones (radius interpolated along each segment).
   /// Thread-safe.
