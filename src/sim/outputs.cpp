@@ -47,12 +47,17 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
   config.recording.gnss_topic = kGnssTopic;
   config.recording.scan_period_s = simulation.lidar().scanPeriod_s();
   const ImuParams& imu = simulation.scenario().imu;
+  config.odometry.imu.accel_noise_density = imu.accel_noise_density;
+  config.odometry.imu.gyro_noise_density = imu.gyro_noise_density;
+  config.odometry.imu.accel_bias_random_walk = imu.accel_bias_random_walk;
+  config.odometry.imu.gyro_bias_random_walk = imu.gyro_bias_random_walk;
+  config.odometry.imu.gravity_mps2 = imu.gravity_mps2;
   const LidarParams& lidar = simulation.scenario().lidar;
   std::string header = fmt::format(
       "# Rig of a simulated recording (taiga simulate --scenario {} --seed {} --duration {}).\n"
       "# Body = IMU frame; the lidar frame is the Ouster sensor frame (points as the Ouster ROS\n"
       "# driver publishes them). Beam geometry: {}.\n"
-      "# Simulated noise (no config keys exist for these yet):\n"
+      "# Simulated noise (the IMU densities are also in odometry.imu below):\n"
       "#   IMU {} Hz: accelerometer noise {} m/s^2/sqrt(Hz), bias walk {} m/s^3/sqrt(Hz), turn-on "
       "{} m/s^2\n"
       "#              gyroscope noise {} rad/s/sqrt(Hz), bias walk {} rad/s^2/sqrt(Hz), turn-on {} "

@@ -29,6 +29,7 @@ TEST(Simulate, WritesARecordingThatReadsBack) {
           .norm(),
       1e-9);
   EXPECT_EQ(config.recording.lidar_topic, kLidarTopic);
+  EXPECT_DOUBLE_EQ(config.odometry.imu.gyro_noise_density, scenario.imu.gyro_noise_density);
 
   io::Recording recording =
       io::openRecording(dir.path() / "recording.bag", config.recording, config.rig);
