@@ -178,6 +178,9 @@ std::optional<ScanOutcome> LidarInertialOdometry::addScan(const io::Scan& scan) 
     }
     if (!first_scan_) {
       first_scan_ = scan;  // initialization needs the next scan too
+      // The attitude is taken from the readings just before the first scan, not from the start
+      // of a recording whose IMU may have run long before the lidar.
+      imu_.dropBefore(scan.t_start_s - 1.0);
       return std::nullopt;
     }
     initialize(*first_scan_, scan);
