@@ -1,0 +1,272 @@
+// Registration of a simulated forest scan to a local map of 15 keyframes, as the odometry does it:
+// from random initial errors up to 1 m and 10 degrees, each method (NDT, D2D-NDT, GICP) must reach
+// 5 cm and 0.5 degrees of the true T_world_body in at least 95 % of trials (issue 5).
+//
+// The case: a 'mixed' forest walk (seed 7). Keyframes are the scans whose end poses lie about 1 m
+// apart along the walk; each is deskewed with the ground truth, put into the world frame with the
+// true pose at the scan's end and voxel-filtered at 0.2 m (the pipeline's local_map_voxel_m). The
+// source is the first scan at least 0.7 m past the last keyframe, deskewed with the truth and
+// voxel-filtered at 0.4 m (the pipeline's registration source), in the body frame. Targets (NDT
+// cells at 4, 2 and 1 m; GICP covariances) are built once, as a local map is, and every trial
+// starts from the truth times a random perturbation on the body side.
+//
+// The lidar is the full OS0-128 head (128 beams x 1024 columns), as in
+// bench/forest_registration_bench.cpp; the binary takes about 15 s on two busy cores (load average
+// 4), most of it simulating the 16 scans and registering (NDT and GICP ~0.15 s per trial); ctest
+// runs each test in its own process, which simulates again: about 30 s in all (label "long").
+// TAIGA_VERBOSE=1 prints every trial.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "registration_data.hpp"
+#include "taiga/core/trajectory.hpp"
+#include "taiga/preprocess/deskew.hpp"
+#include "taiga/preprocess/voxel_filter.hpp"
+#include "taiga/registration/gicp.hpp"
+#include "taiga/registration/ndt.hpp"
+#include "taiga/registration/registration.hpp"
+#include "taiga/registration/voxel_statistics.hpp"
+#include "taiga/sim/simulator.hpp"
+
+namespace taiga::registration {
+namespace {
+
+using Points = std::vector<Eigen::Vector3d>;
+
+constexpr int kKeyframes = 15;
+constexpr double kKeyframeSpacing_m = 1.0;
+constexpr double kSourceBeyondLastKeyframe_m = 0.7;
+constexpr int kTrials = 30;
+
+struct ForestCase {
+  Points map_points;  ///< world frame, 15 keyframes at 0.2 m
+  Points source;      ///< body frame at the scan's end, 0.4 m
+  lie::SE3 T_world_body;
+  double source_to_last_keyframe_m = 0.0;
+  double keyframe_span_m = 0.0;  ///< first to last keyframe, straight line
+};
+
+// The true T_world_body every millisecond over [t0 - 10 ms, t1 + 10 ms] (not before 0).
+Trajectory truthAround(const sim::WalkingMotion& motion, double t0_s, double t1_s) {
+  Trajectory trajectory;
+  const double start = std::max(0.0, t0_s - 0.01);
+  const int n = static_cast<int>(std::ceil((t1_s + 0.01 - start) / 0.001));
+  for (int i = 0; i <= n; ++i) {
+    const double t = start + 0.001 * i;
+    trajectory.append(t, motion.at(t).T_world_body);
+  }
+  return trajectory;
+}
+
+// Scan `index` deskewed with the ground truth to the body frame at its end; the true pose there.
+PointCloud deskewedScan(const sim::Simulation& simulation, std::uint64_t index,
+                        lie::SE3* T_world_body_end) {
+  const sim::LidarSimulator& lidar = simulation.lidar();
+  const io::Scan scan = lidar.simulateScan(simulation.scene(), simulation.motion(), index,
+                                           static_cast<double>(index) * lidar.scanPeriod_s());
+  *T_world_body_end = simulation.motion().at(scan.t_end_s).T_world_body;
+  const Trajectory truth = truthAround(simulation.motion(), scan.t_start_s, scan.t_end_s);
+  return preprocess::deskew(scan.cloud_in_lidar, lidar.T_body_lidar(), truth, scan.t_end_s)
+      .cloud_in_body;
+}
+
+ForestCase makeForestCase(int beams, int columns, std::uint64_t seed) {
+  sim::Scenario scenario = sim::scenarioByName("mixed");
+  scenario.lidar.beams = beams;
+  scenario.lidar.columns = columns;
+  const sim::Simulation simulation(scenario, 30.0, seed);
+  const sim::LidarSimulator& lidar = simulation.lidar();
+  const double period = lidar.scanPeriod_s();
+  // End time of scan i as the simulator fires it (last column), for choosing scans by the truth.
+  const auto endOf = [&](std::uint64_t i) {
+    return (static_cast<double>(i) + (lidar.columns() - 1.0) / lidar.columns()) * period;
+  };
+  const auto positionAt = [&](double t) {
+    return simulation.motion().at(t).T_world_body.translation();
+  };
+
+  std::vector<std::uint64_t> keyframes = {0};
+  std::uint64_t i = 1;
+  for (; keyframes.size() < kKeyframes && i < simulation.scanCount(); ++i) {
+    if ((positionAt(endOf(i)) - positionAt(endOf(keyframes.back()))).norm() >= kKeyframeSpacing_m)
+      keyframes.push_back(i);
+  }
+  std::uint64_t source_index = i;
+  while (source_index < simulation.scanCount() &&
+         (positionAt(endOf(source_index)) - positionAt(endOf(keyframes.back()))).norm() <
+             kSourceBeyondLastKeyframe_m) {
+    ++source_index;
+  }
+  if (keyframes.size() < kKeyframes || source_index >= simulation.scanCount()) {
+    throw std::runtime_error("the simulated walk is too short for 15 keyframes");
+  }
+
+  ForestCase out;
+  for (const std::uint64_t k : keyframes) {
+    lie::SE3 T_world_body;
+    const PointCloud cloud =
+        preprocess::voxelFilter(deskewedScan(simulation, k, &T_world_body), 0.2);
+    for (const Eigen::Vector3d& p : cloud.positions) out.map_points.push_back(T_world_body * p);
+  }
+  out.source =
+      preprocess::voxelFilter(deskewedScan(simulation, source_index, &out.T_world_body), 0.4)
+          .positions;
+  out.source_to_last_keyframe_m =
+      (out.T_world_body.translation() - positionAt(endOf(keyframes.back()))).norm();
+  out.keyframe_span_m =
+      (positionAt(endOf(keyframes.back())) - positionAt(endOf(keyframes.front()))).norm();
+  return out;
+}
+
+const ForestCase& forestCase() {
+  static const ForestCase c = [] {
+    const auto start = std::chrono::steady_clock::now();
+    ForestCase out = makeForestCase(128, 1024, 7);
+    std::printf(
+        "forest case: map %zu points (15 keyframes over %.1f m), source %zu points %.2f m past"
+        " the last keyframe; simulated in %.1f s\n",
+        out.map_points.size(), out.keyframe_span_m, out.source.size(),
+        out.source_to_last_keyframe_m,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    return out;
+  }();
+  return c;
+}
+
+struct Trials {
+  int successes = 0;
+  int trials = 0;
+  std::vector<double> errors_m, errors_deg;  ///< of every trial
+  double median_ms = 0.0;
+};
+
+// `align(guess)` registers the source from `guess`; trials from truth * random perturbation.
+template <class Align>
+Trials runTrials(const char* name, const lie::SE3& truth, unsigned seed, const Align& align) {
+  std::mt19937 rng(seed);
+  Trials out;
+  std::vector<double> times_ms;
+  for (int i = 0; i < kTrials; ++i) {
+    const lie::SE3 guess = truth * test::randomPerturbation(rng, 1.0, 10.0);
+    const auto start = std::chrono::steady_clock::now();
+    const RegistrationResult r = align(guess);
+    times_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+    const test::PoseError e = test::poseError(r.T_target_source, truth);
+    const test::PoseError e0 = test::poseError(guess, truth);
+    const bool ok = e.translation_m < 0.05 && e.rotation_deg < 0.5;
+    if (std::getenv("TAIGA_VERBOSE") != nullptr) {
+      std::printf(
+          "  %s trial %2d: start %.2f m %4.1f deg -> %.4f m %.3f deg, %d it, %s%s, %.0f ms\n", name,
+          i, e0.translation_m, e0.rotation_deg, e.translation_m, e.rotation_deg, r.iterations,
+          r.converged ? "converged" : "not converged: ", r.reason.c_str(), times_ms.back());
+    }
+    ++out.trials;
+    if (ok) ++out.successes;
+    out.errors_m.push_back(e.translation_m);
+    out.errors_deg.push_back(e.rotation_deg);
+  }
+  std::sort(times_ms.begin(), times_ms.end());
+  out.median_ms = times_ms[times_ms.size() / 2];
+  auto m = out.errors_m, d = out.errors_deg;
+  std::sort(m.begin(), m.end());
+  std::sort(d.begin(), d.end());
+  std::printf(
+      "%s: %d / %d within 5 cm and 0.5 deg; error median %.4f m %.3f deg, max %.4f m %.3f deg;"
+      " median %.0f ms per registration\n",
+      name, out.successes, out.trials, m[m.size() / 2], d[d.size() / 2], m.back(), d.back(),
+      out.median_ms);
+  return out;
+}
+
+// NDT (P2D or D2D) coarse to fine over prebuilt targets of the map, coarsest first, as
+// alignNdt(source, target points) does with targets built per call.
+std::vector<NdtTarget> ndtTargets(const Points& map, const NdtConfig& config) {
+  std::vector<double> resolutions = config.coarse_resolutions_m;
+  std::sort(resolutions.begin(), resolutions.end(), std::greater<>());
+  resolutions.push_back(config.resolution_m);
+  std::vector<NdtTarget> targets;
+  for (const double r : resolutions) {
+    VoxelStatistics stats(r);
+    stats.add(map);
+    targets.emplace_back(stats, config.min_points_per_cell, config.min_eigenvalue_ratio);
+  }
+  return targets;
+}
+
+template <class AlignOne>
+RegistrationResult coarseToFine(const std::vector<NdtTarget>& targets, const lie::SE3& guess,
+                                const AlignOne& align_one) {
+  lie::SE3 T = guess;
+  RegistrationResult result;
+  int iterations = 0;
+  for (const NdtTarget& target : targets) {
+    result = align_one(target, T);
+    iterations += result.iterations;
+    if (result.num_inliers == 0) break;
+    T = result.T_target_source;
+  }
+  result.iterations = iterations;
+  return result;
+}
+
+NdtConfig ndtConfig() {
+  NdtConfig config;  // 1 m cells, DIRECT7, outlier ratio 0.55 (the odometry's defaults)
+  config.coarse_resolutions_m = {4.0, 2.0};
+  return config;
+}
+
+TEST(ForestRegistration, MapAndSourceAreWhatTheCaseSays) {
+  const ForestCase& c = forestCase();
+  EXPECT_GT(c.map_points.size(), 50000u);
+  EXPECT_GT(c.source.size(), 3000u);
+  EXPECT_GT(c.keyframe_span_m, 5.0);  // a walk, not 15 copies of one viewpoint
+  EXPECT_GE(c.source_to_last_keyframe_m, kSourceBeyondLastKeyframe_m - 0.05);
+}
+
+TEST(ForestRegistration, NdtFromRandomInitialErrors) {
+  const ForestCase& c = forestCase();
+  const NdtConfig config = ndtConfig();
+  const std::vector<NdtTarget> targets = ndtTargets(c.map_points, config);
+  const Trials t = runTrials("ndt", c.T_world_body, 11, [&](const lie::SE3& guess) {
+    return coarseToFine(targets, guess, [&](const NdtTarget& target, const lie::SE3& g) {
+      return alignNdt(c.source, target, g, config);
+    });
+  });
+  EXPECT_GE(t.successes, 0.95 * t.trials);
+}
+
+TEST(ForestRegistration, D2dNdtFromRandomInitialErrors) {
+  const ForestCase& c = forestCase();
+  const NdtConfig config = ndtConfig();
+  const std::vector<NdtTarget> targets = ndtTargets(c.map_points, config);
+  const Trials t = runTrials("d2d", c.T_world_body, 12, [&](const lie::SE3& guess) {
+    return coarseToFine(targets, guess, [&](const NdtTarget& target, const lie::SE3& g) {
+      return alignD2dNdt(c.source, target, g, config);
+    });
+  });
+  EXPECT_GE(t.successes, 0.95 * t.trials);
+}
+
+TEST(ForestRegistration, GicpFromRandomInitialErrors) {
+  const ForestCase& c = forestCase();
+  const GicpConfig config;  // 10 neighbours, 1 m maximum correspondence distance
+  const GicpCloud target(c.map_points, config);
+  const GicpCloud source(c.source, config);
+  const Trials t = runTrials("gicp", c.T_world_body, 13, [&](const lie::SE3& guess) {
+    return alignGicp(source, target, guess, config);
+  });
+  EXPECT_GE(t.successes, 0.95 * t.trials);
+}
+
+}  // namespace
+}  // namespace taiga::registration
