@@ -50,7 +50,7 @@ LidarInertialOdometry::LidarInertialOdometry(const OdometryConfig& config, const
       rig_(rig),
       gravity_world_(0.0, 0.0, -config.imu.gravity_mps2),
       smoother_({.gravity_world = gravity_world_, .window_states = config.window_states}),
-      local_map_(config.ndt_resolution_m, config.local_map_keyframes),
+      local_map_(config.ndt_resolution_m, config.local_map_voxel_m, config.local_map_keyframes),
       levelled_(config.gravity_alignment_s <= 0.0) {}
 
 LidarInertialOdometry::~LidarInertialOdometry() = default;
@@ -343,7 +343,8 @@ void LidarInertialOdometry::levelWorld(ScanOutcome& outcome) {
   smoother_.initialize(levelled);
   // The keyframes so far were deskewed with the velocity still unknown (zero at the start): the
   // local map starts over from this scan, deskewed with the velocity the odometry has found.
-  local_map_ = LocalMap(config_.ndt_resolution_m, config_.local_map_keyframes);
+  local_map_ =
+      LocalMap(config_.ndt_resolution_m, config_.local_map_voxel_m, config_.local_map_keyframes);
   last_keyframe_T_world_body_.reset();
   outcome.T_world_body = poseOf(levelled.state);
   outcome.v_world = levelled.state.v_world;
