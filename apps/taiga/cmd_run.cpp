@@ -15,10 +15,12 @@ struct RunOptions {
   bool realtime = false;
   bool ply = false;
   double map_voxel_m = 0.0;
+  std::string registration;
 };
 
 int run(const RunOptions& options) {
   SystemConfig config = loadConfig(options.config);
+  if (!options.registration.empty()) config.odometry.method = options.registration;
   validateAll(config);
   const pipeline::RunSummary s = pipeline::runOdometry(options.recording, config,
                                                        {.out_dir = options.out,
@@ -53,6 +55,10 @@ Command addRunCommand(CLI::App& tool) {
   parser->add_option("--out", options->out, "Output directory")->required();
   parser->add_flag("--realtime", options->realtime, "Play the recording at sensor rate");
   parser->add_flag("--ply", options->ply, "Also write map.ply");
+  parser
+      ->add_option("--registration", options->registration,
+                   "Scan-to-map registration (overrides odometry.method)")
+      ->check(CLI::IsMember({"ndt", "d2d", "gicp"}));
   parser
       ->add_option("--map-voxel", options->map_voxel_m,
                    "Decimate the map to one point per voxel of this size, m")

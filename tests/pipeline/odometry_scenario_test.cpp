@@ -4,8 +4,12 @@
 // converges; the thesis' 0.2-0.9 % is over 100-280 m. A broken deskew, gravity alignment,
 // registration or IMU factor fails these bounds by a wide margin.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 #include "../support/temp_dir.hpp"
 #include "taiga/core/system_config.hpp"
@@ -17,6 +21,11 @@
 
 namespace taiga::pipeline {
 namespace {
+
+std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 struct ScenarioRun {
   RunSummary summary;
@@ -41,7 +50,7 @@ ScenarioRun simulateAndRun(const std::string& scenario_name, double duration_s, 
   return run;
 }
 
-TEST(OdometryScenario, MixedForestWalkStaysWithinCentimetres) {
+TEST(OdometryScenario, MixedForestWalkStaysWithinCentimetresAndRepeatsExactly) {
   test::TempDir dir;
   const ScenarioRun run = simulateAndRun("mixed", 15.0, 3, dir.path());
   const RunSummary& s = run.summary;
@@ -55,6 +64,19 @@ TEST(OdometryScenario, MixedForestWalkStaysWithinCentimetres) {
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "run" / "map.las"));
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "run" / "summary.json"));
   RecordProperty("ape_rmse_m", std::to_string(run.evaluation.ape.translation_m.rmse));
+
+  // The same recording again on one thread: the same trajectory, bit for bit.
+  {
+    const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    SystemConfig config;
+    io::readConfigYaml(dir.path() / "recording" / "rig.yaml", config);
+    runOdometry(dir.path() / "recording" / "recording.bag", config,
+                {.out_dir = dir.path() / "rerun", .show_progress = false});
+  }
+  EXPECT_EQ(readFile(dir.path() / "run" / "trajectory.tum"),
+            readFile(dir.path() / "rerun" / "trajectory.tum"));
+  EXPECT_EQ(readFile(dir.path() / "run" / "trajectory_imu.tum"),
+            readFile(dir.path() / "rerun" / "trajectory_imu.tum"));
   RecordProperty("drift_percent", std::to_string(run.evaluation.drift.drift_percent));
 }
 
