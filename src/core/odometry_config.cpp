@@ -30,6 +30,10 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.choice("method", method, kMethods,
            "scan-to-map registration: ndt, d2d (distribution-to-distribution) or gicp");
   v.field("ndt_resolution_m", ndt_resolution_m, "m, NDT cell size of the local map");
+  static constexpr std::array<std::string_view, 2> kNeighbours{"direct1", "direct7"};
+  v.choice("ndt_neighbours", ndt_neighbours, kNeighbours,
+           "NDT cells each scan point is scored against: its own (direct1) or also the six face "
+           "neighbours (direct7)");
   v.field("local_map_voxel_m", local_map_voxel_m, "m, spacing of keyframe points in the local map");
   v.field("local_map_keyframes", local_map_keyframes, "keyframes held in the local map");
   v.field("lidar_sigma", lidar_sigma,

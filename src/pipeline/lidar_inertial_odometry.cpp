@@ -247,6 +247,8 @@ registration::RegistrationResult LidarInertialOdometry::registerToMap(
     const std::vector<Eigen::Vector3d>& source, const lie::SE3& guess_T_world_body) {
   registration::NdtConfig ndt;
   ndt.resolution_m = config_.ndt_resolution_m;
+  ndt.search = config_.ndt_neighbours == "direct1" ? registration::NeighbourSearch::kDirect1
+                                                   : registration::NeighbourSearch::kDirect7;
   registration::RegistrationResult result;
   if (config_.method == "gicp") {
     result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),

@@ -27,8 +27,9 @@ struct OdometryConfig final : ConfigSection {
   // Registration to the local map.
   std::string method = "ndt";  ///< ndt | d2d | gicp
   double ndt_resolution_m = 1.0;
-  double local_map_voxel_m = 0.2;  ///< keyframe points enter the local map at this spacing
-  int local_map_keyframes = 20;    ///< keyframes the local map holds
+  std::string ndt_neighbours = "direct1";  ///< direct1 | direct7: NDT cells scored per point
+  double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
+  int local_map_keyframes = 20;            ///< keyframes the local map holds
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
   double lidar_sigma = 0.01;            ///< sigma_sm: m and rad, at good fitness
   double fitness_threshold_m2 = 0.3;    ///< tau_fs
