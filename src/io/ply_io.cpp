@@ -193,11 +193,11 @@ LoadedPoints parsePly(const std::string& text) {
         throw InputError("truncated: fewer lines than vertices");
       loaded.bytes.resize(bytes);
       for (std::uint64_t i = 0; i < element.count; ++i) {
+        if (pos >= text.size())
+          throw InputError(fmt::format("truncated: {} of {} vertices", i, element.count));
         const std::size_t end = std::min(text.find('\n', pos), text.size());
         const std::vector<std::string> w =
             splitWords(std::string_view(text).substr(pos, end - pos));
-        if (pos >= text.size())
-          throw InputError(fmt::format("truncated: {} of {} vertices", i, element.count));
         pos = end + 1;
         if (w.size() < packed.fields.size())
           throw InputError(
