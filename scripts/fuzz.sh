@@ -2,10 +2,13 @@
 # Builds the libFuzzer targets with clang (address and undefined-behaviour sanitizers) into
 # build-fuzz/ and runs each for SECONDS (default 20), starting from real files as seeds. A crash,
 # a sanitizer report or a hang fails the script and leaves the input in build-fuzz/findings/.
-# Usage: scripts/fuzz.sh [SECONDS]
+# Usage: scripts/fuzz.sh [SECONDS] [SEED]. With a SEED the mutations are the same every run (CI
+# uses one, so that a landing does not depend on luck); without one each run explores anew.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
+seed_option=()
+if [ $# -ge 2 ]; then seed_option=(-seed="$2"); fi
 
 if [ ! -f build-fuzz/CMakeCache.txt ]; then
   CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -35,7 +38,7 @@ mkdir -p build-fuzz/findings
 for target in $targets; do
   echo "fuzz: $target for $seconds s"
   corpus=$(seed "$target")
-  build-fuzz/bin/$target "$corpus" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 -print_final_stats=0 \
+  build-fuzz/bin/$target "$corpus" "${seed_option[@]}" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 -print_final_stats=0 \
     -artifact_prefix=build-fuzz/findings/"$target"- 2>&1 | tail -n 3
 done
 echo "fuzz: no crash in $(echo $targets | wc -w) targets"
