@@ -1,20 +1,24 @@
 // Score, gradient and Hessian of P2D- and D2D-NDT (see ndt.hpp for the model).
 //
-// With T(tau) = T * Exp(tau), a source point x moves to p(tau) = R x(tau) + t where
-//   x(tau) = Exp(tau) x = x + rho + theta x x + 1/2 theta x rho + 1/2 theta x (theta x x) + O(3).
-// Hence dp/dtau = R [I, -[x]x] and, for a vector w = R^T Sigma^-1 (p - mu), the contraction of the
-// second derivatives (p - mu)^T Sigma^-1 d2p/dtau2 is the symmetric 6x6
-//   [ 0            1/2 [w]x                          ]
-//   [ -1/2 [w]x    1/2 (w x^T + x w^T) - (w . x) I   ].
+// The terms are accumulated for a perturbation on the left, in the target frame, where a moved
+// point needs no rotation: with p = T x and p(tau) = Exp(tau) p,
+//   p(tau) = p + rho + theta x p + 1/2 theta x rho + 1/2 theta x (theta x p) + O(3),
+// so dp/dtau = J = [I, -[p]x] and, for a = Sigma^-1 (p - mu), the contraction of the second
+// derivatives a^T d2p/dtau2 is the symmetric 6x6
+//   S = [ 0            1/2 [a]x                          ]
+//       [ -1/2 [a]x    1/2 (a p^T + p a^T) - (a . p) I   ].
 // For one point and one cell with q = (p - mu)^T Sigma^-1 (p - mu), e = exp(-d2 q / 2), f = d1 e:
-//   df/dtau    = -d1 d2 e g,                         g = J^T Sigma^-1 (p - mu)
-//   d2f/dtau2  = -d1 d2 e (-d2 g g^T + J^T Sigma^-1 J + S(w))   (Magnusson Eq. 6.12-6.13).
+//   df/dtau    = -d1 d2 e g,                         g = J^T a = [a; p x a]
+//   d2f/dtau2  = -d1 d2 e (-d2 g g^T + J^T Sigma^-1 J + S)   (Magnusson Eq. 6.12-6.13).
+// The optimizer perturbs on the right, T Exp(tau_r) = Exp(Adj(T) tau_r) T, so the sums are mapped
+// once per evaluation: g_r = Adj^T g, H_r = Adj^T H Adj (exact: the map between tau_r and tau is
+// linear). Per point this needs no 3x6 Jacobian products, and only the upper triangle of H is
+// accumulated: about a third of the arithmetic of the right-perturbation form.
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <vector>
 
 #include "block_reduce.hpp"
-#include "taiga/lie/so3.hpp"
 #include "taiga/registration/ndt.hpp"
 
 namespace taiga::registration {
@@ -23,16 +27,15 @@ namespace {
 struct Partial {
   double score = 0.0;
   lie::Vector6 gradient = lie::Vector6::Zero();
-  lie::Matrix6 hessian = lie::Matrix6::Zero();
+  lie::Matrix6 hessian = lie::Matrix6::Zero();  ///< upper triangle only until finished
   std::size_t num_inliers = 0;
 };
 
-// Adds the contribution of source point x (source frame) moved to p, scored against a cell with
-// mean mu and inverse covariance B.
-inline void accumulate(const Eigen::Vector3d& x, const Eigen::Matrix3d& R,
-                       const Eigen::Matrix<double, 3, 6>& J, const Eigen::Vector3d& p,
-                       const Eigen::Vector3d& mu, const Eigen::Matrix3d& B, const NdtConstants& k,
-                       bool with_hessian, Partial& out) {
+// Adds the contribution of the moved point p (target frame) scored against a cell with mean mu
+// and inverse covariance B, in the left-perturbation form above.
+inline void accumulate(const Eigen::Vector3d& p, const Eigen::Vector3d& mu,
+                       const Eigen::Matrix3d& B, const NdtConstants& k, bool with_hessian,
+                       Partial& out) {
   const Eigen::Vector3d d = p - mu;
   const Eigen::Vector3d a = B * d;
   const double q = d.dot(a);
@@ -42,41 +45,52 @@ inline void accumulate(const Eigen::Vector3d& x, const Eigen::Matrix3d& R,
   if (!(exponent < 50.0)) return;
   const double e = std::exp(-exponent);
   out.score += k.d1 * e;
-  const lie::Vector6 g = J.transpose() * a;
   const double c = -k.d1 * k.d2 * e;  // > 0
+  lie::Vector6 g;
+  g << a, p.cross(a);
   out.gradient += c * g;
   if (!with_hessian) return;
-  const Eigen::Vector3d w = R.transpose() * a;
-  lie::Matrix6 S = lie::Matrix6::Zero();
-  const Eigen::Matrix3d w_hat = lie::hat(w);
-  S.block<3, 3>(0, 3) = 0.5 * w_hat;
-  S.block<3, 3>(3, 0) = -0.5 * w_hat;
-  S.block<3, 3>(3, 3) =
-      0.5 * (w * x.transpose() + x * w.transpose()) - w.dot(x) * Eigen::Matrix3d::Identity();
-  const Eigen::Matrix<double, 3, 6> BJ = B * J;
-  out.hessian += c * (-k.d2 * g * g.transpose() + J.transpose() * BJ + S);
-}
-
-inline Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Matrix3d& R,
-                                                 const Eigen::Vector3d& x) {
-  Eigen::Matrix<double, 3, 6> J;
-  J.leftCols<3>() = R;
-  J.rightCols<3>() = -R * lie::hat(x);
-  return J;
+  // BP = B [p]x column by column ([p]x e_j = p x e_j), then [p]x^T B [p]x row by row (row i of
+  // [p]x^T is (p x e_i)^T).
+  Eigen::Matrix3d BP;
+  BP.col(0) = p.z() * B.col(1) - p.y() * B.col(2);
+  BP.col(1) = p.x() * B.col(2) - p.z() * B.col(0);
+  BP.col(2) = p.y() * B.col(0) - p.x() * B.col(1);
+  Eigen::Matrix3d PtBP;
+  PtBP.row(0) = p.z() * BP.row(1) - p.y() * BP.row(2);
+  PtBP.row(1) = p.x() * BP.row(2) - p.z() * BP.row(0);
+  PtBP.row(2) = p.y() * BP.row(0) - p.x() * BP.row(1);
+  const double cg = -c * k.d2;
+  const double a_dot_p = a.dot(p);
+  // [a]x entries for the off-diagonal block of S.
+  const double a_hat[3][3] = {{0.0, -a.z(), a.y()}, {a.z(), 0.0, -a.x()}, {-a.y(), a.x(), 0.0}};
+  lie::Matrix6& H = out.hessian;
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i <= j; ++i) H(i, j) += c * B(i, j) + cg * g[i] * g[j];
+    for (int i = 0; i < 3; ++i) {
+      H(i, j + 3) += c * (-BP(i, j) + 0.5 * a_hat[i][j]) + cg * g[i] * g[j + 3];
+    }
+    for (int i = 0; i <= j; ++i) {
+      const double s = 0.5 * (a[i] * p[j] + p[i] * a[j]) - (i == j ? a_dot_p : 0.0);
+      H(i + 3, j + 3) += c * (PtBP(i, j) + s) + cg * g[i + 3] * g[j + 3];
+    }
+  }
 }
 
 template <class Body>
-NdtDerivatives reduce(std::size_t n, const Body& body) {
+NdtDerivatives reduce(std::size_t n, const lie::SE3& T_target_source, const Body& body) {
   const Partial total = detail::reduceInBlocks<Partial>(n, body, [](Partial& a, const Partial& b) {
     a.score += b.score;
     a.gradient += b.gradient;
     a.hessian += b.hessian;
     a.num_inliers += b.num_inliers;
   });
+  const lie::Matrix6 adjoint = T_target_source.adjoint();
+  const lie::Matrix6 hessian_left = total.hessian.selfadjointView<Eigen::Upper>();
   NdtDerivatives out;
   out.score = total.score;
-  out.gradient = total.gradient;
-  out.hessian = total.hessian;
+  out.gradient = adjoint.transpose() * total.gradient;
+  out.hessian = adjoint.transpose() * hessian_left * adjoint;
   out.num_inliers = total.num_inliers;
   return out;
 }
@@ -96,16 +110,14 @@ NdtDerivatives ndtDerivatives(std::span<const Eigen::Vector3d> source, const Ndt
   const NdtConstants k = ndtConstants(target.resolution_m(), config.outlier_ratio);
   const Eigen::Matrix3d R = T_target_source.rotation().matrix();
   const Eigen::Vector3d t = T_target_source.translation();
-  return reduce(source.size(), [&](std::size_t i, Partial& out) {
-    const Eigen::Vector3d& x = source[i];
-    const Eigen::Vector3d p = R * x + t;
+  return reduce(source.size(), T_target_source, [&](std::size_t i, Partial& out) {
+    const Eigen::Vector3d p = R * source[i] + t;
     const NdtCell* cells[7];
     const int n = target.neighbours(p, config.search, cells);
     if (n == 0) return;
     ++out.num_inliers;
-    const Eigen::Matrix<double, 3, 6> J = pointJacobian(R, x);
     for (int c = 0; c < n; ++c) {
-      accumulate(x, R, J, p, cells[c]->mean, cells[c]->inverse_covariance, k, with_hessian, out);
+      accumulate(p, cells[c]->mean, cells[c]->inverse_covariance, k, with_hessian, out);
     }
   });
 }
@@ -130,18 +142,16 @@ NdtDerivatives d2dDerivatives(const D2dSource& source, const NdtTarget& target,
   const NdtConstants k = ndtConstants(target.resolution_m(), config.outlier_ratio);
   const Eigen::Matrix3d R = T_target_source.rotation().matrix();
   const Eigen::Vector3d t = T_target_source.translation();
-  return reduce(source.means.size(), [&](std::size_t i, Partial& out) {
-    const Eigen::Vector3d& x = source.means[i];
-    const Eigen::Vector3d p = R * x + t;
+  return reduce(source.means.size(), T_target_source, [&](std::size_t i, Partial& out) {
+    const Eigen::Vector3d p = R * source.means[i] + t;
     const NdtCell* cells[7];
     const int n = target.neighbours(p, config.search, cells);
     if (n == 0) return;
     ++out.num_inliers;
-    const Eigen::Matrix<double, 3, 6> J = pointJacobian(R, x);
     const Eigen::Matrix3d RCRt = R * source.covariances[i] * R.transpose();
     for (int c = 0; c < n; ++c) {
       const Eigen::Matrix3d B = (RCRt + cells[c]->covariance).inverse();
-      accumulate(x, R, J, p, cells[c]->mean, B, k, with_hessian, out);
+      accumulate(p, cells[c]->mean, B, k, with_hessian, out);
     }
   });
 }
