@@ -15,6 +15,7 @@
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/io/ouster/sensor_info.hpp"
+#include "taiga/sim/machine.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim {
@@ -113,7 +114,9 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   struct Column {
     Eigen::Matrix3d R_world_lidar;
     Eigen::Vector3d origin_lidar, origin_world;
+    std::optional<MachineSnapshot> machine;  ///< the harvester's cabin and crane, if any
   };
+  const HarvesterMachine* machine = motion.machine();
   std::vector<Column> columns(cols);
   std::vector<SubHit> centers(pixels.size(), SubHit{kNoHit, 0.0, 0.0});
   std::vector<std::uint8_t> solid(pixels.size(), 0);
@@ -130,8 +133,8 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
         std::vector<std::optional<RayHit>> column_hits;
         for (int col = range.begin(); col != range.end(); ++col) {
           const double t = t_start_s + col * dt_column;
-          const lie::SE3 T_world_lidar =
-              motion.at(t).T_world_body * T_body_sensor * geometry_.T_sensor_lidar;
+          const lie::SE3 T_world_body = motion.at(t).T_world_body;
+          const lie::SE3 T_world_lidar = T_world_body * T_body_sensor * geometry_.T_sensor_lidar;
           const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
           Column& c = columns[col];
           c.R_world_lidar = T_world_lidar.rotation().matrix();
@@ -143,6 +146,10 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
           for (int row = 0; row < rows; ++row) dirs[row] = c.R_world_lidar * direction(col, row);
           scene.castRays(c.origin_world, dirs, params_.max_range_m * 1.2,
                          column_hits);  // packets of 16
+          if (machine) {  // the machine's own body: nearest hit wins
+            c.machine = machine->snapshot(t, T_world_body);
+            c.machine->occlude(c.origin_world, dirs, params_.max_range_m * 1.2, column_hits);
+          }
           for (int row = 0; row < rows; ++row) {
             const auto& hit = column_hits[row];
             if (!hit) continue;
@@ -203,7 +210,8 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
             const double a = spin + 2.0 * kPi * (k - 1) / (k_rays - 1);
             const Eigen::Vector3d dir =
                 (d_world + std::tan(ring_rad) * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
-            const auto hit = scene.castRay(c.origin_world, dir, 0.0, params_.max_range_m * 1.2);
+            auto hit = scene.castRay(c.origin_world, dir, 0.0, params_.max_range_m * 1.2);
+            if (c.machine) c.machine->occlude(c.origin_world, dir, params_.max_range_m * 1.2, hit);
             if (!hit) continue;
             const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(dir)));
             hits[n_hits++] = {hit->range_m, ring_weight, reflectivity(hit->material) * cos_inc};

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "machine_boxes_output.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
 
@@ -68,6 +69,7 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
       imu.accel_bias_random_walk, imu.accel_turn_on_bias, imu.gyro_noise_density,
       imu.gyro_bias_random_walk, imu.gyro_turn_on_bias, lidar.range_noise_m,
       lidar.range_noise_per_m, lidar.beam_divergence_deg);
+  if (simulation.motion().machine()) header += cabinBoxRigComment();
   writeText(path, header + io::writeConfigYaml(config));
 }
 

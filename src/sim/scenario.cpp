@@ -7,7 +7,7 @@
 namespace taiga::sim {
 
 std::vector<std::string> scenarioNames() {
-  return {"mixed", "sparse_pine", "dense_spruce", "open_field", "strip_road"};
+  return {"mixed", "sparse_pine", "dense_spruce", "open_field", "strip_road", "harvester"};
 }
 
 Scenario scenarioByName(const std::string& name) {
@@ -53,6 +53,15 @@ Scenario scenarioByName(const std::string& name) {
     f.road_half_width_m = 2.5;
     s.motion.loop_aspect = 0.04;  // out along one wheel track, back along the other
     s.motion.look_around_deg = 12.0;
+    return s;
+  }
+  if (name == "harvester") {  // a harvester thinning along the strip road, IMU at 500 Hz
+    s = scenarioByName("strip_road");
+    s.name = name;
+    s.motion = MotionParams{};
+    s.motion.model = MotionModel::kHarvester;
+    s.motion.sensor_height_m = 3.8;  // on the cabin roof
+    s.imu.rate_hz = 500.0;
     return s;
   }
   std::string names;

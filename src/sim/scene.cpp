@@ -87,6 +87,8 @@ double reflectivity(Material material) {
       return 0.3;
     case Material::kDeadWood:
       return 0.4;
+    case Material::kMachine:
+      return 0.5;  // yellow or green paint, some dirt
   }
   return 0.3;
 }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "machine_boxes_output.hpp"
 #include "outputs.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/io/rosbag.hpp"
@@ -71,6 +72,9 @@ SimulationSummary writeSimulation(const Simulation& simulation,
     }
   };
 
+  std::optional<detail::MachineBoxesWriter> machine_boxes;  // harvester: crop boxes per scan
+  if (const HarvesterMachine* machine = motion.machine())
+    machine_boxes.emplace(out_dir / "machine_boxes.csv", *machine);
   const std::size_t scans = simulation.scanCount();
   const io::ScanGrid grid{static_cast<std::uint32_t>(lidar.rows()),
                           static_cast<std::uint32_t>(lidar.columns())};
@@ -79,6 +83,8 @@ SimulationSummary writeSimulation(const Simulation& simulation,
     const io::Scan scan = lidar.simulateScan(scene, motion, k, t_start, kRecordingEpoch_s);
     emitUntil(scan.t_end_s - kRecordingEpoch_s);
     bag.writeScan(kLidarTopic, "os_sensor", scan, grid);
+    if (machine_boxes)
+      machine_boxes->writeScan(scan.t_start_s, t_start, scan.t_end_s - kRecordingEpoch_s);
     const std::size_t n = scan.cloud_in_lidar.size();
     summary.points += n;
     summary.min_points_per_scan = std::min(summary.min_points_per_scan, n);

@@ -16,21 +16,175 @@ WalkingMotion makeMotion(double duration_s = 60.0, const MotionParams& params = 
   return WalkingMotion(params, duration_s, 1, Terrain(ForestParams{}, 1));
 }
 
+/// Central differences of the pose and velocity against the analytic velocity, acceleration and
+/// angular rate. h = 1e-5 s keeps the truncation error of the 30 Hz vibration small.
+void expectDerivativesMatch(const Motion& motion, double t) {
+  SCOPED_TRACE(t);
+  const double h = 1e-5;
+  const MotionState s = motion.at(t), before = motion.at(t - h), after = motion.at(t + h);
+  const Eigen::Vector3d v_num =
+      (after.T_world_body.translation() - before.T_world_body.translation()) / (2 * h);
+  const Eigen::Vector3d a_num = (after.v_world - before.v_world) / (2 * h);
+  const Eigen::Vector3d omega_num =
+      after.T_world_body.rotation().minus(before.T_world_body.rotation()) / (2 * h);
+  EXPECT_LT((v_num - s.v_world).norm(), 2e-5);
+  EXPECT_LT((a_num - s.a_world).norm(), 2e-4);
+  EXPECT_LT((omega_num - s.omega_body).norm(), 2e-6);
+}
+
+/// Yaw rate about the world's vertical, rad/s.
+double worldYawRate(const MotionState& s) {
+  return (s.T_world_body.rotation() * s.omega_body).z();
+}
+
+Motion makeHarvester(double duration_s, MotionParams params = {}) {
+  params.model = MotionModel::kHarvester;
+  params.sensor_height_m = 3.8;
+  return Motion(params, duration_s, 1, Terrain(ForestParams{}, 1));
+}
+
 TEST(WalkingMotion, DerivativesMatchNumericalDifferentiation) {
-  const WalkingMotion motion = makeMotion();
-  const double h = 1e-4;
-  for (const double t : {0.0, 3.3, 17.9, 41.05}) {
-    SCOPED_TRACE(t);
-    const MotionState s = motion.at(t), before = motion.at(t - h), after = motion.at(t + h);
-    const Eigen::Vector3d v_num =
-        (after.T_world_body.translation() - before.T_world_body.translation()) / (2 * h);
-    const Eigen::Vector3d a_num = (after.v_world - before.v_world) / (2 * h);
-    const Eigen::Vector3d omega_num =
-        after.T_world_body.rotation().minus(before.T_world_body.rotation()) / (2 * h);
-    EXPECT_LT((v_num - s.v_world).norm(), 1e-6);
-    EXPECT_LT((a_num - s.a_world).norm(), 1e-5);
-    EXPECT_LT((omega_num - s.omega_body).norm(), 1e-6);
+  const WalkingMotion motion = makeMotion(120.0);
+  for (const double t : {0.0, 3.3, 17.9, 41.05}) expectDerivativesMatch(motion, t);
+  // Across pauses: while slowing down, standing, and getting going again.
+  const auto pauses = motion.standStills();
+  ASSERT_GE(pauses.size(), 2u);
+  for (const StandStill& p : pauses) {
+    for (const double t : {p.start_s - 0.73, p.start_s + 0.2, p.end_s - 0.1, p.end_s + 0.61})
+      expectDerivativesMatch(motion, t);
   }
+  // Across the fastest turn.
+  double t_fastest = 0.0, fastest = 0.0;
+  for (double t = 0.0; t < 120.0; t += 0.01) {
+    const double rate = std::abs(worldYawRate(motion.at(t)));
+    if (rate > fastest) fastest = rate, t_fastest = t;
+  }
+  for (const double dt : {-0.5, -0.1, 0.0, 0.07, 0.4}) expectDerivativesMatch(motion, t_fastest + dt);
+}
+
+TEST(HarvesterMotion, DerivativesMatchNumericalDifferentiation) {
+  const Motion motion = makeHarvester(200.0);
+  for (const double t : {0.0, 2.9, 4.1, 7.77}) expectDerivativesMatch(motion, t);
+  for (const StandStill& stop : motion.standStills()) {
+    // Ramps of the drives and (within tree handling) the vibration bursts.
+    for (double t = stop.start_s - 1.5; t < stop.end_s + 1.5; t += 0.37) expectDerivativesMatch(motion, t);
+  }
+}
+
+TEST(WalkingMotion, PausesStopTheWalkForTheirDuration) {
+  MotionParams params;
+  const WalkingMotion motion = makeMotion(300.0, params);
+  const auto pauses = motion.standStills();
+  ASSERT_GE(pauses.size(), 5u);  // one every ~30 s of walking
+  for (const StandStill& p : pauses) {
+    SCOPED_TRACE(p.start_s);
+    EXPECT_GE(p.end_s - p.start_s, params.pause_min_s);
+    EXPECT_LE(p.end_s - p.start_s, params.pause_max_s);
+    // Standing: only the stick's sway moves the sensor (a few cm), walking would cover metres.
+    const Eigen::Vector3d p0 = motion.at(p.start_s).T_world_body.translation();
+    for (double t = p.start_s; t <= p.end_s; t += 0.05) {
+      EXPECT_LT((motion.at(t).T_world_body.translation() - p0).head<2>().norm(), 0.06);
+    }
+    // Slowing down before: at full speed 1.5 s earlier, about half speed at mid-ramp.
+    EXPECT_GT(motion.at(p.start_s - params.pause_ramp_s - 0.3).v_world.head<2>().norm(), 0.6);
+    EXPECT_GT((motion.at(p.start_s - params.pause_ramp_s).T_world_body.translation() - p0).norm(),
+              0.3);
+  }
+  // The same walk without pauses is at its start again sooner.
+  params.pause_interval_s = 0.0;
+  EXPECT_TRUE(makeMotion(300.0, params).standStills().empty());
+}
+
+TEST(WalkingMotion, FastTurnsReachAboutNinetyDegreesPerSecond) {
+  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+  auto maxYawRate = [](const Motion& motion, double duration_s) {
+    double fastest = 0.0;
+    for (double t = 0.0; t < duration_s; t += 0.005)
+      fastest = std::max(fastest, std::abs(worldYawRate(motion.at(t))));
+    return fastest * kDegPerRad;
+  };
+  MotionParams params;
+  const double with_turns = maxYawRate(makeMotion(300.0, params), 300.0);
+  EXPECT_GT(with_turns, 80.0);
+  EXPECT_LT(with_turns, 95.0);
+  params.fast_turn_interval_s = 0.0;
+  const double without = maxYawRate(makeMotion(300.0, params), 300.0);
+  EXPECT_LT(without, 65.0);  // the look-around swings alone
+  EXPECT_GT(without, 20.0);
+}
+
+TEST(WalkingMotion, SameSeedSameMotion) {
+  const WalkingMotion a = makeMotion(100.0), b = makeMotion(100.0);
+  const WalkingMotion other(MotionParams{}, 100.0, 2, Terrain(ForestParams{}, 1));
+  const Motion h1 = makeHarvester(100.0), h2 = makeHarvester(100.0);
+  bool differs = false;
+  for (double t = 0.0; t < 100.0; t += 0.731) {
+    EXPECT_EQ(a.at(t).T_world_body.matrix(), b.at(t).T_world_body.matrix());
+    EXPECT_EQ(a.at(t).a_world, b.at(t).a_world);
+    EXPECT_EQ(h1.at(t).T_world_body.matrix(), h2.at(t).T_world_body.matrix());
+    EXPECT_EQ(h1.at(t).omega_body, h2.at(t).omega_body);
+    differs |= (a.at(t).T_world_body.translation() - other.at(t).T_world_body.translation()).norm() > 1.0;
+  }
+  EXPECT_TRUE(differs);
+}
+
+TEST(WalkingMotion, CloverleafReturnsThroughTheStartAreaSeveralTimes) {
+  MotionParams params;
+  params.loop_lobes = 4;
+  params.max_loop_length_m = 600.0;
+  const WalkingMotion motion = makeMotion(900.0, params);  // the cloverleaf twice
+  const Eigen::Vector2d start = motion.at(0.0).T_world_body.translation().head<2>();
+  // Count the passes through the start area and where each lobe reaches out to.
+  int passes = 0;
+  bool inside = true;
+  std::vector<Eigen::Vector2d> tips;
+  Eigen::Vector2d farthest = start;
+  double path_m = 0.0;
+  Eigen::Vector2d prev = start;
+  for (double t = 0.0; t < motion.loopPeriod_s(); t += 0.1) {
+    const Eigen::Vector2d p = motion.at(t).T_world_body.translation().head<2>();
+    path_m += (p - prev).norm();
+    prev = p;
+    const bool near = (p - start).norm() < 6.0;
+    if (near && !inside) {
+      ++passes;
+      tips.push_back(farthest);
+      farthest = start;
+    }
+    if (!near && (p - start).norm() > (farthest - start).norm()) farthest = p;
+    inside = near;
+  }
+  EXPECT_NEAR(path_m, 600.0, 40.0);
+  EXPECT_GE(passes, 4);  // back through the start after every lobe
+  ASSERT_GE(tips.size(), 4u);
+  // Four lobes in four directions, of different sizes.
+  double min_reach = 1e9, max_reach = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const double reach = (tips[i] - start).norm();
+    min_reach = std::min(min_reach, reach), max_reach = std::max(max_reach, reach);
+    for (std::size_t j = 0; j < i; ++j) {
+      const double cos_angle = (tips[i] - start).normalized().dot((tips[j] - start).normalized());
+      EXPECT_LT(cos_angle, 0.5) << i << " " << j;
+    }
+  }
+  EXPECT_GT(min_reach, 30.0);
+  EXPECT_GT(max_reach, 1.2 * min_reach);
+  // Back at the start after the first round, and again after the second.
+  EXPECT_LT((motion.at(motion.loopPeriod_s()).T_world_body.translation().head<2>() - start).norm(),
+            0.15);
+  // Nearly constant walking speed along the lobes (the arc-length reparametrization).
+  double speed_min = 1e9, speed_max = 0.0;
+  for (double t = 1.0; t < 60.0; t += 0.05) {
+    bool paused = false;
+    for (const StandStill& p : motion.standStills())
+      paused |= t > p.start_s - params.pause_ramp_s - 0.5 && t < p.end_s + params.pause_ramp_s + 0.5;
+    if (paused) continue;
+    const double v = motion.at(t).v_world.head<2>().norm();
+    speed_min = std::min(speed_min, v), speed_max = std::max(speed_max, v);
+  }
+  // 1.35 m/s +- 25 %, +- 0.17 m/s of the stick's sway
+  EXPECT_GT(speed_min, 0.75);
+  EXPECT_LT(speed_max, 1.95);
 }
 
 TEST(WalkingMotion, WalksAtHandheldSpeedAndReturnsToItsStart) {

@@ -32,12 +32,23 @@ struct ForestParams {
   double path_clearance_m = 1.0;      ///< no stem closer than this to the walked path, m
 };
 
+/// Which rig moves through the forest.
+enum class MotionModel {
+  kHandheld,   ///< a person walking with the scanner on a stick
+  kHarvester,  ///< a forest harvester on a strip road (needs forest.road_half_width_m > 0)
+};
+
 struct MotionParams {
+  MotionModel model = MotionModel::kHandheld;
   double speed_mps = 1.35;             ///< mean walking speed, m/s
   double sensor_height_m = 2.2;        ///< sensor (body) height above the ground, m
   double loop_aspect = 1.0;            ///< loop's y radius / x radius (strip road: thin loop)
   double max_loop_length_m = 300.0;    ///< longer recordings walk the loop again
   double shape_perturbation = 0.18;    ///< relative amplitude of the loop's wiggles
+  /// 1: one loop; 3 or 4: a cloverleaf of that many lobes that all pass through the start
+  /// area (max_loop_length_m is then the length of the whole cloverleaf)
+  int loop_lobes = 1;
+  double lobe_size_variation = 0.3;    ///< relative size difference of the lobes (0 .. 0.6)
   double speed_variation = 0.25;       ///< relative amplitude of speed changes
   double look_around_deg = 25.0;       ///< slow yaw swings about the walking direction, deg
   double look_around_fast_deg = 10.0;  ///< faster yaw swings, deg
@@ -47,6 +58,36 @@ struct MotionParams {
   double roll_sway_deg = 3.0;          ///< roll oscillation at half the step frequency, deg
   double pitch_sway_deg = 2.5;         ///< pitch oscillation at the step frequency, deg
   double pitch_mean_deg = -3.0;        ///< mean pitch (nose down negative about y), deg
+  // Pauses of the operator: speed goes smoothly to zero, stays there, and comes back.
+  double pause_interval_s = 30.0;  ///< mean walking time between pauses, s (0: no pauses)
+  double pause_min_s = 2.0;        ///< shortest standing time of a pause, s
+  double pause_max_s = 6.0;        ///< longest standing time of a pause, s
+  double pause_ramp_s = 1.5;       ///< time to slow down to a stop, and to get going again, s
+  // Fast turns: the operator looks aside quickly (a smooth bump in yaw) and back.
+  double fast_turn_interval_s = 15.0;  ///< mean time between fast turns, s (0: none)
+  double fast_turn_min_deg = 60.0;     ///< smallest turn away from the walking direction, deg
+  double fast_turn_max_deg = 120.0;    ///< largest turn, deg
+  /// peak yaw rate during a turn, everything included, deg/s (each turn draws 75-100 % of it)
+  double fast_turn_rate_deg_s = 90.0;
+  // Harvester (model = kHarvester): drives along the strip road (world x) from tree to tree.
+  double harvester_speed_min_mps = 0.3;      ///< slowest drive between trees, m/s
+  double harvester_speed_max_mps = 1.0;      ///< fastest drive, m/s
+  double harvester_drive_min_m = 4.0;        ///< shortest drive from one tree stop to the next, m
+  double harvester_drive_max_m = 12.0;       ///< longest drive, m
+  double harvester_stop_min_s = 20.0;        ///< shortest stop to fell and process a tree, s
+  double harvester_stop_max_s = 60.0;        ///< longest stop, s
+  double harvester_ramp_s = 2.0;             ///< time to speed up from, or slow down to, 0, s
+  double harvester_reverse_probability = 0.3;  ///< after a stop: back up a few metres first
+  double harvester_reverse_max_m = 4.0;        ///< longest reversing, m (shortest: 1.5 m)
+  double harvester_lateral_m = 0.3;  ///< slow side-to-side weave on the road, amplitude, m
+  /// vibration bursts while a tree is handled: peak linear acceleration per axis (vertical: 1.5x)
+  double harvester_vibration_mps2 = 4.0;
+  double harvester_vibration_rate_deg_s = 4.0;  ///< peak angular rate per axis, deg/s
+  double harvester_vibration_min_hz = 10.0;     ///< lowest vibration frequency, Hz
+  double harvester_vibration_max_hz = 30.0;     ///< highest vibration frequency, Hz
+
+  /// InputError naming the field (`motion.<field>`) for values out of range.
+  void validate() const;
 };
 
 struct LidarParams {

@@ -21,7 +21,15 @@
 namespace taiga::sim {
 
 enum class Species : std::uint8_t { kPine, kSpruce, kBirch, kSapling };
-enum class Material : std::uint8_t { kGround, kBark, kBranch, kFoliage, kRock, kDeadWood };
+enum class Material : std::uint8_t {
+  kGround,
+  kBark,
+  kBranch,
+  kFoliage,
+  kRock,
+  kDeadWood,
+  kMachine,  ///< the harvester's painted steel (cabin, crane), see machine.hpp
+};
 
 /// Reflectivity of a material at the lidar's 865 nm, in [0, 1].
 double reflectivity(Material material);
