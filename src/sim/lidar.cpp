@@ -93,6 +93,19 @@ LidarGeometry loadLidarGeometry(const LidarParams& params) {
 LidarSimulator::LidarSimulator(LidarParams params, LidarGeometry geometry, std::uint64_t seed)
     : params_(std::move(params)), geometry_(std::move(geometry)), seed_(streamSeed(seed, "lidar")) {
   params_.sub_rays = std::clamp(params_.sub_rays, 1, kMaxSubRays);
+  // The beam directions in the lidar frame are the same in every scan: computed once here
+  // (the sines and cosines per pixel and pass cost a few per cent of a scan).
+  const int rows = this->rows(), cols = params_.columns;
+  directions_lidar_.resize(static_cast<std::size_t>(rows) * cols);
+  for (int col = 0; col < cols; ++col) {
+    const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
+    for (int row = 0; row < rows; ++row) {
+      const double az = theta_e - geometry_.beam_azimuth_deg[row] * kDeg;
+      const double alt = geometry_.beam_altitude_deg[row] * kDeg;
+      directions_lidar_[static_cast<std::size_t>(col) * rows + row] = Eigen::Vector3d(
+          std::cos(az) * std::cos(alt), std::sin(az) * std::cos(alt), std::sin(alt));
+    }
+  }
 }
 
 io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& motion,
@@ -120,12 +133,8 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   std::vector<Column> columns(cols);
   std::vector<SubHit> centers(pixels.size(), SubHit{kNoHit, 0.0, 0.0});
   std::vector<std::uint8_t> solid(pixels.size(), 0);
-  auto direction = [&](int col, int row) {
-    const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
-    const double az = theta_e - geometry_.beam_azimuth_deg[row] * kDeg;
-    const double alt = geometry_.beam_altitude_deg[row] * kDeg;
-    return Eigen::Vector3d(std::cos(az) * std::cos(alt), std::sin(az) * std::cos(alt),
-                           std::sin(alt));
+  auto direction = [&](int col, int row) -> const Eigen::Vector3d& {
+    return directions_lidar_[static_cast<std::size_t>(col) * rows + row];
   };
   tbb::parallel_for(
       tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>& range) {

@@ -295,7 +295,9 @@ void Scene::castRays(const Eigen::Vector3d& origin_world,
     }
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    // The 16 beams of a packet fan out over about 11 deg of elevation: incoherent rays, for which
+    // Embree's hybrid traversal is about 5 % faster than with the coherent hint (sim_bench).
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcIntersect16(valid, impl_->scene, &context, &rh);
     for (std::size_t i = 0; i < count; ++i) {
       if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;

@@ -63,6 +63,8 @@ class LidarSimulator {
   LidarParams params_;
   LidarGeometry geometry_;
   std::uint64_t seed_;
+  /// Unit direction of every beam in the lidar frame, column-major (column * rows + row).
+  std::vector<Eigen::Vector3d> directions_lidar_;
 };
 
 }  // namespace taiga::sim
