@@ -16,6 +16,7 @@ struct RunOptions {
   bool ply = false;
   double map_voxel_m = 0.0;
   std::string registration;
+  std::string moving_boxes;
 };
 
 int run(const RunOptions& options) {
@@ -26,7 +27,8 @@ int run(const RunOptions& options) {
                                                        {.out_dir = options.out,
                                                         .write_ply = options.ply,
                                                         .map_voxel_m = options.map_voxel_m,
-                                                        .realtime = options.realtime});
+                                                        .realtime = options.realtime,
+                                                        .moving_boxes_file = options.moving_boxes});
   fmt::print("scans      {} read, {} processed; {} IMU samples; {:.1f} s, {:.1f} m of path\n",
              s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
   fmt::print("lidar      {} registrations rejected, {} inflated; {} keyframes, {} map points\n",
@@ -63,6 +65,11 @@ Command addRunCommand(CLI::App& tool) {
       ->add_option("--map-voxel", options->map_voxel_m,
                    "Decimate the map to one point per voxel of this size, m")
       ->check(CLI::NonNegativeNumber);
+  parser
+      ->add_option("--moving-boxes", options->moving_boxes,
+                   "CSV of per-scan boxes (body frame) around moving parts of the rig, e.g. a "
+                   "harvester's boom; returns inside are dropped (docs/recordings.md)")
+      ->check(CLI::ExistingFile);
   return {parser, [options] { return run(*options); }, options};
 }
 

@@ -17,6 +17,7 @@ class ValidatingVisitor final : public ConfigVisitor {
   void field(std::string_view, std::string&, std::string_view) override {}
   void field(std::string_view, Eigen::Vector3d&, std::string_view) override {}
   void field(std::string_view, lie::SE3&, std::string_view) override {}
+  void field(std::string_view, std::vector<Box>&, std::string_view) override {}
   void choice(std::string_view, std::string&, std::span<const std::string_view>,
               std::string_view) override {}
   void section(std::string_view key, ConfigSection& value, std::string_view) override {

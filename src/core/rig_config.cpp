@@ -16,6 +16,9 @@ void RigConfig::visit(ConfigVisitor& v) {
   }};
   enumField(v, "imu_acceleration_unit", imu_acceleration_unit, kUnits,
             "unit of the IMU acceleration: m/s^2 (mps2), standard gravity (g) or auto-detect");
+  v.field("self_boxes_body", self_boxes_body,
+          "boxes {min_m, max_m} in the body frame around the rig itself (operator, cabin); "
+          "returns inside are dropped");
 }
 
 void RigConfig::validate() const {

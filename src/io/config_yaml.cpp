@@ -9,6 +9,7 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <tuple>
 #include <vector>
 
 #include "numeric_text.hpp"
@@ -192,6 +193,42 @@ lie::SE3 parsePose(const Mapping& parent, std::string_view key, const YAML::Node
   return lie::SE3(rotation, translation);
 }
 
+// A list of boxes, each {min_m: [x, y, z], max_m: [x, y, z]} with min <= max on every axis; an
+// empty list or null is no box.
+std::vector<Box> parseBoxes(const Mapping& parent, std::string_view key, const YAML::Node& node) {
+  std::vector<Box> boxes;
+  if (node.IsNull()) return boxes;
+  if (!node.IsSequence()) {
+    parent.fail(node.Mark(), key,
+                fmt::format("expected a list of boxes {{min_m: [x, y, z], max_m: [x, y, z]}}, got {}",
+                            describe(node)));
+  }
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node& entry = node[i];
+    const std::string entry_key = fmt::format("{}[{}]", key, i);
+    if (!entry.IsMap()) {
+      parent.fail(entry.Mark(), entry_key,
+                  fmt::format("expected a mapping with min_m and max_m, got {}", describe(entry)));
+    }
+    Mapping m(entry, parent.prefix() + entry_key + ".", parent.source());
+    const auto min_node = m.take("min_m");
+    const auto max_node = m.take("max_m");
+    m.rejectUnknownKeys();
+    Box box;
+    for (auto [name, node_of_corner, corner] :
+         {std::tuple{"min_m", &min_node, &box.min_m}, {"max_m", &max_node, &box.max_m}}) {
+      if (!*node_of_corner) m.fail(entry.Mark(), name, "missing: every box needs min_m and max_m");
+      const auto v = parseNumbers(m, name, **node_of_corner, 3, "[x, y, z] in m");
+      *corner = Eigen::Vector3d(v[0], v[1], v[2]);
+    }
+    if (!(box.min_m.array() <= box.max_m.array()).all()) {
+      m.fail(entry.Mark(), "max_m", "expected max_m >= min_m on every axis");
+    }
+    boxes.push_back(box);
+  }
+  return boxes;
+}
+
 class YamlReader final : public ConfigVisitor {
  public:
   YamlReader(const YAML::Node& node, std::string prefix, const std::string& source)
@@ -242,6 +279,9 @@ class YamlReader final : public ConfigVisitor {
   }
   void field(std::string_view key, lie::SE3& value, std::string_view) override {
     if (auto node = mapping_.take(key)) value = parsePose(mapping_, key, *node, value);
+  }
+  void field(std::string_view key, std::vector<Box>& value, std::string_view) override {
+    if (auto node = mapping_.take(key)) value = parseBoxes(mapping_, key, *node);
   }
   void choice(std::string_view key, std::string& value, std::span<const std::string_view> allowed,
               std::string_view) override {
@@ -301,6 +341,18 @@ class YamlWriter final : public ConfigVisitor {
     out_ << YAML::Key << "quaternion_xyzw" << YAML::Value;
     numbers({q.x(), q.y(), q.z(), q.w()});
     out_ << YAML::EndMap;
+  }
+  void field(std::string_view key, std::vector<Box>& value, std::string_view doc) override {
+    out_ << YAML::Key << std::string(key) << YAML::Comment(std::string(doc)) << YAML::Value
+         << YAML::BeginSeq;
+    for (const Box& box : value) {
+      out_ << YAML::Flow << YAML::BeginMap << YAML::Key << "min_m" << YAML::Value;
+      numbers({box.min_m.x(), box.min_m.y(), box.min_m.z()});
+      out_ << YAML::Key << "max_m" << YAML::Value;
+      numbers({box.max_m.x(), box.max_m.y(), box.max_m.z()});
+      out_ << YAML::EndMap;
+    }
+    out_ << YAML::EndSeq;
   }
   void choice(std::string_view key, std::string& value, std::span<const std::string_view> allowed,
               std::string_view doc) override {

@@ -51,7 +51,11 @@ LidarInertialOdometry::LidarInertialOdometry(const OdometryConfig& config, const
       gravity_world_(0.0, 0.0, -config.imu.gravity_mps2),
       smoother_({.gravity_world = gravity_world_, .window_states = config.window_states}),
       local_map_(config.ndt_resolution_m, config.local_map_voxel_m, config.local_map_keyframes),
-      levelled_(config.gravity_alignment_s <= 0.0) {}
+      levelled_(config.gravity_alignment_s <= 0.0) {
+  const lie::SE3 T_lidar_body = rig_.T_body_lidar.inverse();
+  for (const Box& box : rig_.self_boxes_body)
+    self_boxes_lidar_.push_back(OrientedBox::fromBox(box).expressedIn(T_lidar_body));
+}
 
 LidarInertialOdometry::~LidarInertialOdometry() = default;
 
@@ -71,6 +75,18 @@ void LidarInertialOdometry::addImu(const ImuSample& sample) {
     logger().debug("IMU reading at {:.6f} s is not after the previous one; ignored", sample.t_s);
 }
 
+// The rig is rigid with the body, so a point is tested against the boxes at its own firing time,
+// before deskewing: exact for any motion during the sweep.
+PointCloud LidarInertialOdometry::forestPointsInLidar(const io::Scan& scan) const {
+  const PointCloud in_range =
+      preprocess::keepRange(scan.cloud_in_lidar, config_.min_range_m, config_.max_range_m);
+  std::vector<OrientedBox> boxes_lidar = self_boxes_lidar_;
+  const lie::SE3 T_lidar_body = rig_.T_body_lidar.inverse();
+  for (const OrientedBox& box_body : moving_boxes_body_.forScan(scan.t_start_s, scan.t_end_s))
+    boxes_lidar.push_back(box_body.expressedIn(T_lidar_body));
+  return preprocess::removeInsideBoxes(in_range, boxes_lidar);
+}
+
 PointCloud LidarInertialOdometry::deskewScan(const io::Scan& scan, const imu::NavState& state_prev,
                                              double t_prev, const imu::ImuBias& bias,
                                              std::vector<StampedPose>* imu_rate_poses) {
@@ -82,9 +98,7 @@ PointCloud LidarInertialOdometry::deskewScan(const io::Scan& scan, const imu::Na
     for (std::size_t k = 1; k < states.size(); ++k)
       imu_rate_poses->push_back({states[k].t_s, poseOf(states[k].state)});
   }
-  const PointCloud in_range =
-      preprocess::keepRange(scan.cloud_in_lidar, config_.min_range_m, config_.max_range_m);
-  return preprocess::deskew(in_range, rig_.T_body_lidar, imu::toTrajectory(states), scan.t_end_s)
+  return preprocess::deskew(forestPointsInLidar(scan), rig_.T_body_lidar, imu::toTrajectory(states), scan.t_end_s)
       .cloud_in_body;
 }
 
@@ -110,16 +124,12 @@ void LidarInertialOdometry::initialize(const io::Scan& first, const io::Scan& se
                                                   readings, init.bias, gravity_world_);
     at_first_end = over_first.back().state;
     first_in_body =
-        preprocess::deskew(
-            preprocess::keepRange(first.cloud_in_lidar, config_.min_range_m, config_.max_range_m),
-            rig_.T_body_lidar, imu::toTrajectory(over_first), first.t_end_s)
+        preprocess::deskew(forestPointsInLidar(first), rig_.T_body_lidar, imu::toTrajectory(over_first), first.t_end_s)
             .cloud_in_body;
     const auto over_second = imu::propagateThrough(at_first_end, first.t_end_s, second.t_end_s,
                                                    readings, init.bias, gravity_world_);
     const PointCloud second_in_body =
-        preprocess::deskew(
-            preprocess::keepRange(second.cloud_in_lidar, config_.min_range_m, config_.max_range_m),
-            rig_.T_body_lidar, imu::toTrajectory(over_second), second.t_end_s)
+        preprocess::deskew(forestPointsInLidar(second), rig_.T_body_lidar, imu::toTrajectory(over_second), second.t_end_s)
             .cloud_in_body;
     std::vector<Eigen::Vector3d> target =
         preprocess::voxelFilter(first_in_body, config_.local_map_voxel_m).positions;

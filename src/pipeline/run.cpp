@@ -16,6 +16,7 @@
 #include "taiga/core/log.hpp"
 #include "taiga/core/progress.hpp"
 #include "taiga/io/cloud_files.hpp"
+#include "taiga/io/moving_boxes.hpp"
 #include "taiga/io/las_writer.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/pipeline/lidar_inertial_odometry.hpp"
@@ -95,6 +96,12 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
 
   io::Recording recording = io::openRecording(recording_path, config.recording, config.rig);
   LidarInertialOdometry odometry(config.odometry, config.rig);
+  if (!options.moving_boxes_file.empty()) {
+    MovingBoxes boxes = io::readMovingBoxes(options.moving_boxes_file);
+    logger().info("{}: moving boxes for {} scans", options.moving_boxes_file.string(),
+                  boxes.stamps());
+    odometry.setMovingBoxes(std::move(boxes));
+  }
 
   std::ofstream timing = openOutput(options.out_dir / "timing.csv");
   timing << "t_s,deskew_ms,filter_ms,registration_ms,optimization_ms,map_ms,total_ms\n";

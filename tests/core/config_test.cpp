@@ -61,6 +61,7 @@ struct ChoiceAnswer final : ConfigVisitor {
   void field(std::string_view, std::string&, std::string_view) override {}
   void field(std::string_view, Eigen::Vector3d&, std::string_view) override {}
   void field(std::string_view, lie::SE3&, std::string_view) override {}
+  void field(std::string_view, std::vector<Box>&, std::string_view) override {}
   void choice(std::string_view, std::string& value, std::span<const std::string_view> names,
               std::string_view) override {
     offered = value;

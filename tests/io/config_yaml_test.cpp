@@ -100,6 +100,23 @@ TEST(ConfigYaml, WrittenConfigReadsBackIdentically) {
             original.T_a_b.rotation().quaternion().coeffs());
 }
 
+TEST(ConfigYaml, ReadsAndWritesTheRigBoxes) {
+  SystemConfig config;
+  readConfigYamlText(
+      "rig:\n  self_boxes_body:\n"
+      "    - {min_m: [-1, -0.5, -2], max_m: [1, 0.5, -0.2]}\n"
+      "    - min_m: [2, 2, 2]\n      max_m: [3, 3, 3]\n",
+      "rig.yaml", config);
+  ASSERT_EQ(config.rig.self_boxes_body.size(), 2u);
+  EXPECT_EQ(config.rig.self_boxes_body[0].min_m, Eigen::Vector3d(-1, -0.5, -2));
+  EXPECT_EQ(config.rig.self_boxes_body[1].max_m, Eigen::Vector3d(3, 3, 3));
+  SystemConfig copy;
+  readConfigYamlText(writeConfigYaml(config), "written.yaml", copy);
+  ASSERT_EQ(copy.rig.self_boxes_body.size(), 2u);
+  EXPECT_EQ(copy.rig.self_boxes_body[0].max_m, config.rig.self_boxes_body[0].max_m);
+  EXPECT_EQ(copy.rig.self_boxes_body[1].min_m, config.rig.self_boxes_body[1].min_m);
+}
+
 TEST(ConfigYaml, EmptyFileMeansDefaults) {
   EXPECT_EQ(read("").voxel_m, 0.4);
   EXPECT_EQ(read("# nothing set\n").threads, 2);
@@ -167,6 +184,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"rig:\n  T_body_lidar:\n    translation_m: [0, 0, 150]\n",
                   "test.yaml:2:3: rig.T_body_lidar.translation_m: expected a value in [0, 10] m "
                   "(length), got 150"},
+        // boxes
+        BadConfig{"rig:\n  self_boxes_body: {min_m: [0, 0, 0]}\n",
+                   "rig.self_boxes_body: expected a list of boxes"},
+        BadConfig{"rig:\n  self_boxes_body:\n    - {min_m: [0, 0, 0]}\n",
+                   "rig.self_boxes_body[0].max_m: missing: every box needs min_m and max_m"},
+        BadConfig{"rig:\n  self_boxes_body:\n    - {min_m: [0, 0, 0], max_m: [1, -1, 1]}\n",
+                   "rig.self_boxes_body[0].max_m: expected max_m >= min_m on every axis"},
+        BadConfig{"rig:\n  self_boxes_body:\n    - {min_m: [0, 0, 0], max: [1, 1, 1]}\n",
+                   "rig.self_boxes_body[0].max: unknown key; did you mean 'max_m'?"},
         // structure
         BadConfig{"voxel_m: 0.5\nvoxel_m: 0.6\n",
                   "test.yaml:2:1: voxel_m: appears twice (first on line 1)"},

@@ -14,6 +14,9 @@
 #include <string_view>
 #include <utility>
 
+#include <vector>
+
+#include "taiga/core/box.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/lie/se3.hpp"
 
@@ -46,6 +49,8 @@ class ConfigVisitor {
   virtual void field(std::string_view key, Eigen::Vector3d& value, std::string_view doc) = 0;
   /// A rigid transform T_a_b, written as translation_m plus quaternion_xyzw or rpy_deg.
   virtual void field(std::string_view key, lie::SE3& value, std::string_view doc) = 0;
+  /// A list of axis-aligned boxes, each written as {min_m: [x, y, z], max_m: [x, y, z]}.
+  virtual void field(std::string_view key, std::vector<Box>& value, std::string_view doc) = 0;
   /// A string restricted to `allowed` (an enumeration).
   virtual void choice(std::string_view key, std::string& value,
                       std::span<const std::string_view> allowed, std::string_view doc) = 0;

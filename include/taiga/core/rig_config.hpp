@@ -20,6 +20,9 @@ struct RigConfig final : ConfigSection {
   double lidar_time_offset_s = 0.0;
   /// Acceleration unit of the IMU; `auto` decides from the magnitude at rest.
   AccelerationUnit imu_acceleration_unit = AccelerationUnit::kAuto;
+  /// Boxes in the body frame around parts of the rig that the lidar sees (the operator, a
+  /// harvester's cabin): returns inside them are dropped before anything else.
+  std::vector<Box> self_boxes_body;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

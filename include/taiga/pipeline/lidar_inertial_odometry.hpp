@@ -82,6 +82,10 @@ class LidarInertialOdometry {
   /// One scan; nothing while the IMU has not yet covered the initialization window.
   std::optional<ScanOutcome> addScan(const io::Scan& scan);
 
+  /// Boxes around moving parts of the rig (a harvester's boom), per scan, in the body frame:
+  /// returns inside the boxes of a scan's time span are dropped.
+  void setMovingBoxes(MovingBoxes boxes_body) { moving_boxes_body_ = std::move(boxes_body); }
+
   bool initialized() const { return smoother_.initialized(); }
   /// The first scan's outcome (its state and keyframe), once, after the scan that initialized.
   std::optional<ScanOutcome> takeFirstOutcome() {
@@ -93,6 +97,8 @@ class LidarInertialOdometry {
 
  private:
   void initialize(const io::Scan& first, const io::Scan& second);
+  /// The scan's returns within the range limits and outside the rig's boxes, in the lidar frame.
+  PointCloud forestPointsInLidar(const io::Scan& scan) const;
   PointCloud deskewScan(const io::Scan& scan, const imu::NavState& state_prev, double t_prev,
                         const imu::ImuBias& bias, std::vector<StampedPose>* imu_rate_poses);
   registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
@@ -106,6 +112,8 @@ class LidarInertialOdometry {
 
   OdometryConfig config_;
   RigConfig rig_;
+  std::vector<OrientedBox> self_boxes_lidar_;  ///< rig.self_boxes_body in the lidar frame
+  MovingBoxes moving_boxes_body_;
   Eigen::Vector3d gravity_world_;
   ImuBuffer imu_;
   backend::OdometrySmoother smoother_;

@@ -23,6 +23,8 @@ struct RunOptions {
   double map_voxel_m = 0.0;   ///< > 0: the map is decimated to one point per voxel per keyframe
   bool realtime = false;      ///< pace the recording at sensor rate
   bool show_progress = true;  ///< a progress line on a terminal
+  /// Per-scan boxes around moving parts of the rig (io/moving_boxes.hpp); empty: none.
+  std::filesystem::path moving_boxes_file;
 };
 
 struct RunSummary {

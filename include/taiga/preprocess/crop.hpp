@@ -6,21 +6,17 @@
 #include <Eigen/Core>
 #include <span>
 
+#include "taiga/core/box.hpp"
 #include "taiga/core/point_cloud.hpp"
 
 namespace taiga::preprocess {
 
-/// An axis-aligned box in the frame of the cloud it is applied to.
-struct Box {
-  Eigen::Vector3d min_m = Eigen::Vector3d::Zero();
-  Eigen::Vector3d max_m = Eigen::Vector3d::Zero();
-  bool contains(const Eigen::Vector3d& p) const {
-    return (p.array() >= min_m.array()).all() && (p.array() <= max_m.array()).all();
-  }
-};
+using taiga::Box;
+using taiga::OrientedBox;
 
-/// The points outside every box, all channels kept, in their order.
+/// The points outside every box (boxes in the cloud's frame), all channels kept, in their order.
 PointCloud removeInsideBoxes(const PointCloud& cloud, std::span<const Box> boxes);
+PointCloud removeInsideBoxes(const PointCloud& cloud, std::span<const OrientedBox> boxes);
 
 /// The points whose distance from the frame's origin lies in [min_range_m, max_range_m].
 PointCloud keepRange(const PointCloud& cloud, double min_range_m, double max_range_m);
