@@ -5,7 +5,8 @@
 // processed. The lidar intersects its rays with these boxes as well as with the forest (nearest
 // hit wins), so the machine occludes part of every scan and returns points, as on a real machine.
 //
-// Body frame = IMU on the cabin roof, x forward, z up; the sensor sits 0.3 m above the roof.
+// Body frame = IMU on the cabin roof, x forward, z up; the sensor sits on a mast 0.6 m above
+// the roof.
 // Dimensions roughly those of an 8-wheel harvester (Ponsse Scorpion / John Deere 1270 class).
 
 #include <Eigen/Core>
