@@ -16,7 +16,7 @@ mkdir -p "$out"
 "$taiga" --version
 "$taiga" simulate --scenario mixed --duration 60 --seed 1 --out "$out/recording"
 "$taiga" run "$out/recording/recording.bag" --config "$out/recording/rig.yaml" --out "$out/run"
-"$taiga" eval --est "$out/run/trajectory.tum" --ref "$out/recording/ground_truth.tum" \
+"$taiga" eval --est "$out/run/trajectory.tum" --ref "$out/recording/groundtruth.tum" \
   --timing "$out/run/timing.csv" --plots "$out/plots"
 echo
 echo "demo: trajectory, map (map.las: open it in CloudCompare), timings and summary in $out/run/,"

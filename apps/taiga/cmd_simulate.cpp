@@ -3,31 +3,37 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 
 #include "command.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/progress.hpp"
+#include "taiga/sim/scenario_yaml.hpp"
 #include "taiga/sim/simulator.hpp"
 
 namespace taiga::app {
 namespace {
 struct SimulateOptions {
   std::string scenario = "mixed";
-  double duration_s = 60.0;
+  std::string overrides;               // YAML file overriding scenario fields
+  std::optional<double> duration_s;    // default: the scenario's duration_s
   std::uint64_t seed = 1;
   std::string out;
-  int beams = 128;
-  int columns = 1024;
-  int sub_rays = 4;
+  std::optional<int> beams;            // command-line values win over the scenario and the file
+  std::optional<int> columns;
+  std::optional<int> sub_rays;
 };
 
 int runSimulate(const SimulateOptions& options) {
+  // Precedence: the named scenario, then the overrides file, then the command line.
   sim::Scenario scenario = sim::scenarioByName(options.scenario);
-  scenario.lidar.beams = options.beams;
-  scenario.lidar.columns = options.columns;
-  scenario.lidar.sub_rays = options.sub_rays;
+  if (!options.overrides.empty()) sim::applyScenarioOverrides(options.overrides, scenario);
+  if (options.beams) scenario.lidar.beams = *options.beams;
+  if (options.columns) scenario.lidar.columns = *options.columns;
+  if (options.sub_rays) scenario.lidar.sub_rays = *options.sub_rays;
+  const double duration_s = options.duration_s.value_or(scenario.duration_s);
   const auto start = std::chrono::steady_clock::now();
-  const sim::Simulation simulation(scenario, options.duration_s, options.seed);
+  const sim::Simulation simulation(scenario, duration_s, options.seed);
   const double build_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const sim::SceneStats stats = simulation.scene().stats();
@@ -37,8 +43,8 @@ int runSimulate(const SimulateOptions& options) {
       scenario.name, options.seed, stats.area_ha, simulation.scene().trees().size(),
       stats.triangles, stats.curve_segments, build_s);
   if (simulation.scanCount() == 0) {
-    throw InputError(fmt::format("--duration {}: shorter than one lidar sweep ({} s)",
-                                 options.duration_s, simulation.lidar().scanPeriod_s()));
+    throw InputError(fmt::format("--duration {}: shorter than one lidar sweep ({} s)", duration_s,
+                                 simulation.lidar().scanPeriod_s()));
   }
   Progress progress("simulating", simulation.scanCount(), "scans");
   const sim::SimulationSummary summary = sim::writeSimulation(
@@ -50,8 +56,8 @@ int runSimulate(const SimulateOptions& options) {
       "simulated {:.1f} s of data in {:.1f} s ({:.2f}x real time)\n",
       options.out, summary.scans, summary.min_points_per_scan, summary.max_points_per_scan,
       summary.scans ? static_cast<double>(summary.points) / summary.scans : 0.0,
-      summary.imu_samples, summary.gnss_fixes, summary.path_length_m, options.duration_s,
-      summary.simulate_s, options.duration_s / summary.simulate_s);
+      summary.imu_samples, summary.gnss_fixes, summary.path_length_m, duration_s,
+      summary.simulate_s, duration_s / summary.simulate_s);
   return kExitOk;
 }
 }  // namespace
@@ -60,31 +66,36 @@ Command addSimulateCommand(CLI::App& tool) {
   auto options = std::make_shared<SimulateOptions>();
   CLI::App* parser = tool.add_subcommand(
       "simulate", "Simulate a lidar-inertial recording in a generated forest, with ground truth");
+  std::string names;
+  for (const std::string& name : sim::scenarioNames()) names += (names.empty() ? "" : ", ") + name;
   parser
-      ->add_option(
-          "--scenario", options->scenario,
-          "Forest and motion scenario: mixed, sparse_pine, dense_spruce, open_field, strip_road")
+      ->add_option("--scenario", options->scenario,
+                   "Forest, rig and motion scenario: " + names +
+                       " (hyphens and underscores are interchangeable)")
       ->capture_default_str();
-  parser->add_option("--duration", options->duration_s, "Recording length, s")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+  parser->add_option("--overrides", options->overrides,
+                     "YAML file overriding scenario fields (forest:, motion:, lidar:, imu:, gnss:; "
+                     "see docs/simulator.md); a recording's scenario.yaml reproduces it");
+  parser->add_option("--duration", options->duration_s,
+                     "Recording length, s (default: the scenario's, e.g. 60 for mixed, 180 for "
+                     "handheld-loop)")
+      ->check(CLI::PositiveNumber);
   parser->add_option("--seed", options->seed, "Random seed; the same seed gives the same recording")
       ->capture_default_str();
   parser->add_option("--out", options->out, "Output directory")->required();
   parser
       ->add_option("--beams", options->beams,
-                   "Lidar rows (128, 64, 32, ...), subsampled from the metadata")
-      ->check(CLI::Range(1, 128))
-      ->capture_default_str();
-  parser->add_option("--columns", options->columns, "Lidar columns per rotation (512, 1024, 2048)")
-      ->check(CLI::IsMember({512, 1024, 2048}))
-      ->capture_default_str();
+                   "Lidar rows (128, 64, 32, ...), subsampled from the metadata (default 128)")
+      ->check(CLI::Range(1, 128));
   parser
-      ->add_option(
-          "--sub-rays", options->sub_rays,
-          "Rays per beam at depth edges for the beam divergence (1: none, about 2x faster)")
-      ->check(CLI::Range(1, 8))
-      ->capture_default_str();
+      ->add_option("--columns", options->columns,
+                   "Lidar columns per rotation (512, 1024, 2048; default 1024)")
+      ->check(CLI::IsMember({512, 1024, 2048}));
+  parser
+      ->add_option("--sub-rays", options->sub_rays,
+                   "Rays per beam at depth edges for the beam divergence (1: none, about 2x "
+                   "faster; default 4)")
+      ->check(CLI::Range(1, 8));
   return {parser, [options] { return runSimulate(*options); }, options};
 }
 

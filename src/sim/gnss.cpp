@@ -107,7 +107,13 @@ std::optional<GnssFix> GnssSimulator::next(const WalkingMotion& motion, const Sc
     error += jump_m_;
     if (hashUniform(seed_, k, 8) < params_.outage_probability * cover) return std::nullopt;
   }
-  const Geodetic g = enuToGeodetic(origin(), p_world + error);
+  Eigen::Vector3d p_enu = p_world;
+  if (params_.world_yaw_deg != 0.0) {  // world x is world_yaw_deg counterclockwise from east
+    const double yaw = params_.world_yaw_deg * kDeg;
+    p_enu.x() = std::cos(yaw) * p_world.x() - std::sin(yaw) * p_world.y();
+    p_enu.y() = std::sin(yaw) * p_world.x() + std::cos(yaw) * p_world.y();
+  }
+  const Geodetic g = enuToGeodetic(origin(), p_enu + error);  // the error is east-north-up
   GnssFix fix;
   fix.t_s = t + time_offset_s;
   fix.latitude_deg = g.latitude_deg;

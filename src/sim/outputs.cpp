@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "machine_boxes_output.hpp"
+#include "truth_outputs.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
 
@@ -20,20 +21,6 @@ void writeText(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path);
   out << text;
   if (!out) throw std::runtime_error(fmt::format("{}: cannot write", path.string()));
-}
-
-const char* speciesName(Species s) {
-  switch (s) {
-    case Species::kPine:
-      return "pine";
-    case Species::kSpruce:
-      return "spruce";
-    case Species::kBirch:
-      return "birch";
-    case Species::kSapling:
-      return "sapling";
-  }
-  return "unknown";
 }
 }  // namespace
 
@@ -85,7 +72,9 @@ void writeSceneJson(const std::filesystem::path& path, const Simulation& simulat
   j["time_epoch_s"] = kRecordingEpoch_s;
   j["world_frame"] = {
       {"description",
-       "east-north-up at the origin below, z up; ground_truth.tum holds T_world_body"},
+       "east-north-up at the origin below turned by world_yaw_deg about up, z up; "
+       "groundtruth.tum holds T_world_body, georef_truth.yaml the frame in EPSG:3067"},
+      {"world_yaw_deg", s.gnss.world_yaw_deg},
       {"origin_latitude_deg", s.gnss.origin_latitude_deg},
       {"origin_longitude_deg", s.gnss.origin_longitude_deg},
       {"origin_height_ellipsoid_m", s.gnss.origin_height_m},

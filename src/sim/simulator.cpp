@@ -6,6 +6,7 @@
 
 #include "machine_boxes_output.hpp"
 #include "outputs.hpp"
+#include "truth_outputs.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/io/rosbag.hpp"
 #include "taiga/io/trajectory_io.hpp"
@@ -53,7 +54,7 @@ SimulationSummary writeSimulation(const Simulation& simulation,
   summary.min_points_per_scan = std::numeric_limits<std::size_t>::max();
 
   io::BagWriter bag(out_dir / "recording.bag");
-  ImuSimulator imu(scenario.imu, simulation.seed());
+  ImuSimulator imu(scenario.imu, simulation.seed(), scenario.gnss.world_yaw_deg);
   GnssSimulator gnss(scenario.gnss, simulation.seed());
   Trajectory ground_truth;
   auto emitUntil = [&](double t_end_s) {
@@ -97,8 +98,11 @@ SimulationSummary writeSimulation(const Simulation& simulation,
   if (summary.scans == 0) summary.min_points_per_scan = 0;
   summary.path_length_m = ground_truth.size() > 1 ? ground_truth.pathLength() : 0.0;
 
-  io::writeTum(out_dir / "ground_truth.tum", ground_truth);
+  io::writeTum(out_dir / "groundtruth.tum", ground_truth);
   detail::writeRigYaml(out_dir / "rig.yaml", simulation);
+  detail::writeTreesCsv(out_dir / "trees.csv", scene);
+  detail::writeGeorefTruthYaml(out_dir / "georef_truth.yaml", simulation);
+  detail::writeScenarioYaml(out_dir / "scenario.yaml", simulation);
   summary.simulate_s = secondsSince(start);
   detail::writeSceneJson(out_dir / "scene.json", simulation, summary);
   return summary;

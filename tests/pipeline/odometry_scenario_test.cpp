@@ -46,7 +46,7 @@ ScenarioRun simulateAndRun(const std::string& scenario_name, double duration_s, 
   run.summary = runOdometry(dir / "recording" / "recording.bag", config,
                             {.out_dir = dir / "run", .show_progress = false});
   run.evaluation = eval::evaluate(io::readTum(dir / "run" / "trajectory.tum"),
-                                  io::readTum(dir / "recording" / "ground_truth.tum"), {});
+                                  io::readTum(dir / "recording" / "groundtruth.tum"), {});
   return run;
 }
 

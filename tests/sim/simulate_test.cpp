@@ -46,6 +46,7 @@ TEST(Simulate, WritesARecordingThatReadsBack) {
       if (imu == 0) first_imu = sample->t_s;
       last_imu = sample->t_s;
       accel_norm_sum += sample->acceleration_imu_mps2.norm();  // gait: +-3 m/s^2 about gravity
+      EXPECT_FALSE(sample->orientation.has_value());  // mixed: the Ouster's 6-axis IMU
       ++imu;
     } else {
       ++gnss;
@@ -58,7 +59,7 @@ TEST(Simulate, WritesARecordingThatReadsBack) {
   EXPECT_LE(gnss, 2u);  // 1 Hz, minus outages under the canopy
   EXPECT_EQ(summary.imu_samples, imu);
 
-  const Trajectory truth = io::readTum(dir.path() / "ground_truth.tum");
+  const Trajectory truth = io::readTum(dir.path() / "groundtruth.tum");
   EXPECT_EQ(truth.size(), imu);
   EXPECT_LT((truth.poseAt(kRecordingEpoch_s + 0.7).translation() -
              simulation.motion().at(0.7).T_world_body.translation())

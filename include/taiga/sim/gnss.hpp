@@ -8,7 +8,8 @@
 // receiver is too optimistic, as real ones often are under trees).
 //
 // The world frame is the local east-north-up frame at (origin_latitude, origin_longitude,
-// origin_height) on the WGS84 ellipsoid; fixes are converted exactly through ECEF.
+// origin_height) on the WGS84 ellipsoid, turned by world_yaw_deg about up (0: world = ENU); fixes
+// are converted exactly through ECEF.
 
 #include <Eigen/Core>
 #include <cstdint>

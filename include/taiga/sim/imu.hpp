@@ -3,8 +3,16 @@
 // f = R_world_body^T (a_world - g_world) with g_world = (0, 0, -g), and angular rate omega_body,
 // both from the exact motion, plus the usual discrete-time noise model (as in Kalibr / GTSAM):
 //   f_k = f_true + b_a,k + sigma_a / sqrt(dt) * n,     b_a,k+1 = b_a,k + sigma_ba * sqrt(dt) * n
-// (same for the gyro), with a random turn-on bias b_0 ~ N(0, turn_on^2) per axis. Not modelled:
-// scale factors, misalignment, g-sensitivity, temperature, an internal orientation filter.
+// (same for the gyro), with a random turn-on bias b_0 ~ N(0, turn_on^2) per axis.
+//
+// Optional orientation output (params.orientation_output), as an IMU module's internal attitude
+// filter without a magnetometer reports it: the true R_enu_body perturbed on the left,
+//   R_reported = Rz(psi_k) Exp([e_x,k, e_y,k, 0]) R_enu_body,
+// with a tilt error e (first-order Gauss-Markov per axis, sigma_tilt, time constant tau:
+// e_k+1 = phi e_k + sqrt(1 - phi^2) sigma_tilt n, phi = exp(-dt / tau)) and a heading error
+// psi_k = offset + random walk (psi_k+1 = psi_k + q sqrt(dt) n). With noise = false the reported
+// orientation is exact. Not modelled: scale factors, misalignment, g-sensitivity, temperature,
+// the filter's response to accelerations (its tilt error does not grow in turns).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -23,7 +31,9 @@ struct ImuBiases {
 /// Produces samples k = 0, 1, 2, ... at t_k = k / rate_hz (motion time) in order.
 class ImuSimulator {
  public:
-  ImuSimulator(ImuParams params, std::uint64_t seed);
+  /// world_yaw_deg: heading of the world frame (angle from east to world x, counterclockwise),
+  /// for the orientation output, which refers to east-north-up (REP-103).
+  ImuSimulator(ImuParams params, std::uint64_t seed, double world_yaw_deg = 0.0);
 
   /// Time of the next sample, motion time.
   double nextTime_s() const { return static_cast<double>(k_) / params_.rate_hz; }
@@ -31,12 +41,22 @@ class ImuSimulator {
   ImuSample next(const WalkingMotion& motion, double time_offset_s = 0.0);
   /// Biases applied to the last sample returned (the turn-on biases before the first).
   const ImuBiases& biases() const { return biases_; }
+  /// Errors of the orientation given with the last sample: tilt about east and north, heading
+  /// about up, rad (zero when the output is off or noise is false).
+  Eigen::Vector3d orientationError_rad() const {
+    return {tilt_error_rad_.x(), tilt_error_rad_.y(), heading_error_rad_};
+  }
 
  private:
+  void advanceOrientationError();
+
   ImuParams params_;
   std::uint64_t seed_;
   std::uint64_t k_ = 0;
   ImuBiases biases_;
+  Eigen::Matrix3d R_enu_world_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector2d tilt_error_rad_ = Eigen::Vector2d::Zero();
+  double heading_error_rad_ = 0.0;
 };
 
 }  // namespace taiga::sim

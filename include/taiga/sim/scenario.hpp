@@ -120,6 +120,17 @@ struct ImuParams {
   double gyro_turn_on_bias = 2.0e-3;       ///< 1-sigma bias per axis at start, rad/s
   double gravity_mps2 = 9.81;
   bool noise = true;  ///< false: exact specific force and angular rate
+  /// true: each sample carries the orientation of an internal attitude filter (AHRS without a
+  /// magnetometer), as 9-axis IMU modules report it; false: a 6-axis IMU such as the one inside
+  /// Ouster sensors (sensor_msgs/Imu orientation_covariance[0] = -1). The reported orientation is
+  /// q_enu_imu (REP-103, what the readers assume) perturbed by the errors below.
+  bool orientation_output = false;
+  double orientation_tilt_error_deg = 0.7;  ///< 1-sigma roll and pitch error, deg
+  double orientation_tilt_correlation_s = 60.0;  ///< Gauss-Markov time of the tilt error, s
+  /// heading drift (random walk): sigma grows as this x sqrt(t), deg/sqrt(s) (0.15: ~3 deg in 7 min)
+  double orientation_heading_walk_deg_per_sqrt_s = 0.15;
+  /// constant heading error, deg: the filter's heading is arbitrary without a magnetometer
+  double orientation_heading_offset_deg = 35.0;
 };
 
 struct GnssParams {
@@ -127,6 +138,10 @@ struct GnssParams {
   double origin_latitude_deg = 61.0;  ///< geodetic position of the world origin (WGS84)
   double origin_longitude_deg = 24.5;
   double origin_height_m = 120.0;          ///< ellipsoidal height of the world origin, m
+  /// Heading of the world frame: angle from local east to world x, counterclockwise, deg
+  /// (0: the world frame is east-north-up at the origin)
+  double world_yaw_deg = 0.0;
+  int georef_epsg = 3067;  ///< projected CRS of georef_truth.yaml (ETRS-TM35FIN)
   double sigma_open_horizontal_m = 0.4;    ///< 1-sigma error without canopy
   double sigma_canopy_horizontal_m = 2.5;  ///< additional 1-sigma error under full canopy
   double vertical_factor = 1.8;            ///< vertical sigma / horizontal sigma
@@ -140,6 +155,7 @@ struct GnssParams {
 
 struct Scenario {
   std::string name = "mixed";
+  double duration_s = 60.0;  ///< length of the recording when `--duration` is not given, s
   ForestParams forest;
   MotionParams motion;
   LidarParams lidar;
@@ -147,9 +163,11 @@ struct Scenario {
   GnssParams gnss;
 };
 
-/// The scenarios `taiga simulate --scenario` knows.
+/// The scenarios `taiga simulate --scenario` knows (canonical names).
 std::vector<std::string> scenarioNames();
-/// The scenario of that name; InputError listing the names otherwise.
+/// The scenario of that name (Scenario::name is then the canonical one); hyphens and underscores
+/// are interchangeable (`open_field` = `open-field`, `sparse-pine` = `sparse_pine`).
+/// InputError listing the names otherwise.
 Scenario scenarioByName(const std::string& name);
 
 }  // namespace taiga::sim

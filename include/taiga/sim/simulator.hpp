@@ -3,9 +3,12 @@
 // the outputs of `taiga simulate` (see docs/simulator.md):
 //   recording.bag      /os_cloud_node/points (Ouster PointCloud2, organized rows x columns),
 //                      /imu/data (sensor_msgs/Imu), /gnss/fix (sensor_msgs/NavSatFix)
-//   ground_truth.tum   T_world_body at the IMU rate (body = IMU frame)
+//   groundtruth.tum    T_world_body at the IMU rate (body = IMU frame)
 //   rig.yaml           the configuration `taiga run` uses for this recording
 //   scene.json         scenario, seed, georeference of the world frame, every stem's truth
+//   trees.csv          one row per stem: base position, DBH, height, lean, species
+//   georef_truth.yaml  the world frame in EPSG:3067 (origin, rotation, scale, T_epsg_world)
+//   scenario.yaml      the effective scenario (taiga simulate --overrides scenario.yaml redoes it)
 
 #include <cstdint>
 #include <filesystem>
