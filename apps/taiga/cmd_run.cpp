@@ -37,6 +37,12 @@ int run(const RunOptions& options) {
       "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {:.2f}x real time; peak "
       "memory {:.0f} MB\n",
       s.mean_ms, s.p95_ms, s.max_ms, s.realtime_factor, s.peak_memory_mb);
+  if (s.realtime) {
+    fmt::print("realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "
+               "{:.1f} ms max from delivery to pose\n",
+               s.realtime->dropped_scans, s.realtime->latency_p50_ms, s.realtime->latency_p95_ms,
+               s.realtime->latency_max_ms);
+  }
   fmt::print(
       "outputs    {}/ (trajectory.tum, trajectory_imu.tum, keyframes.tum, map.las{}, timing.csv, "
       "scans.csv, "
@@ -55,7 +61,9 @@ Command addRunCommand(CLI::App& tool) {
       ->required();
   addConfigOption(*parser, options->config);
   parser->add_option("--out", options->out, "Output directory")->required();
-  parser->add_flag("--realtime", options->realtime, "Play the recording at sensor rate");
+  parser->add_flag("--realtime", options->realtime,
+                   "Replay at sensor rate as a live sensor would deliver it: scans are dropped "
+                   "when more than 2 wait, and dropped scans and latency are reported");
   parser->add_flag("--ply", options->ply, "Also write map.ply");
   parser
       ->add_option("--registration", options->registration,

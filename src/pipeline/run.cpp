@@ -9,9 +9,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numeric>
-#include <thread>
 #include <vector>
 
+#include "realtime_feed.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/core/progress.hpp"
@@ -62,7 +62,7 @@ Trajectory transformed(const Trajectory& trajectory, const lie::SE3& T_new_old) 
 
 void writeSummary(const std::filesystem::path& path, const RunSummary& s,
                   const std::filesystem::path& recording) {
-  const nlohmann::ordered_json j = {
+  nlohmann::ordered_json j = {
       {"recording", recording.string()},
       {"scans", s.scans},
       {"scans_processed", s.scans_processed},
@@ -81,6 +81,13 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"peak_memory_mb", s.peak_memory_mb},
       {"initialization", s.initialization},
   };
+  if (s.realtime) {
+    j["realtime"] = {{"dropped_scans", s.realtime->dropped_scans},
+                     {"latency_ms",
+                      {{"p50", s.realtime->latency_p50_ms},
+                       {"p95", s.realtime->latency_p95_ms},
+                       {"max", s.realtime->latency_max_ms}}}};
+  }
   openOutput(path) << j.dump(2) << "\n";
 }
 
@@ -123,7 +130,6 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   Progress progress("taiga run", 0, "scans", stderr,
                     options.show_progress && isatty(fileno(stderr)));
   const auto wall_start = Clock::now();
-  std::optional<double> first_event_s;
 
   auto consume = [&](const ScanOutcome& outcome) {
     ++summary.scans_processed;
@@ -162,21 +168,15 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       ++summary.keyframes;
     }
   };
-  std::size_t stream = 0;
-  while (std::optional<io::RecordingEvent> event = recording.next(&stream)) {
-    const double t_event = io::eventTime(*event);
-    if (!first_event_s) first_event_s = t_event;
-    if (options.realtime) {
-      std::this_thread::sleep_until(wall_start +
-                                    std::chrono::duration<double>(t_event - *first_event_s));
-    }
-    if (const auto* imu = std::get_if<ImuSample>(&*event)) {
+  // Returns whether the event was a scan.
+  auto handle = [&](const io::RecordingEvent& event) {
+    if (const auto* imu = std::get_if<ImuSample>(&event)) {
       odometry.addImu(*imu);
       ++summary.imu_samples;
-      continue;
+      return false;
     }
-    const auto* scan = std::get_if<io::Scan>(&*event);
-    if (!scan) continue;  // GNSS fixes: used by georeferencing, not by the odometry
+    const auto* scan = std::get_if<io::Scan>(&event);
+    if (!scan) return false;  // GNSS fixes: used by georeferencing, not by the odometry
     ++summary.scans;
     const std::optional<ScanOutcome> outcome = odometry.addScan(*scan);
     progress.update(summary.scans);
@@ -187,6 +187,23 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
         emitMap(pending_map[k], summary.keyframes - pending_map.size() + k);
       pending_map.clear();
     }
+    return true;
+  };
+  if (options.realtime) {
+    std::vector<double> latencies_ms;
+    RealtimeFeed feed(recording, options.realtime_queue_scans);
+    while (std::optional<RealtimeFeed::Delivery> delivery = feed.next()) {
+      if (handle(delivery->event)) {
+        latencies_ms.push_back(
+            std::chrono::duration<double, std::milli>(Clock::now() - delivery->delivered).count());
+      }
+    }
+    summary.realtime = RealtimeReport{.dropped_scans = feed.droppedScans(),
+                                      .latency_p50_ms = percentile(latencies_ms, 0.5),
+                                      .latency_p95_ms = percentile(latencies_ms, 0.95),
+                                      .latency_max_ms = percentile(latencies_ms, 1.0)};
+  } else {
+    while (std::optional<io::RecordingEvent> event = recording.next()) handle(*event);
   }
   for (std::size_t k = 0; k < pending_map.size(); ++k)
     emitMap(pending_map[k], summary.keyframes - pending_map.size() + k);

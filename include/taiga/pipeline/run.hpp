@@ -11,6 +11,7 @@
 //   summary.json         counts, per-scan time statistics, real-time factor, peak memory
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "taiga/core/system_config.hpp"
@@ -21,10 +22,18 @@ struct RunOptions {
   std::filesystem::path out_dir;
   bool write_ply = false;     ///< also map.ply (holds the map in memory until the end)
   double map_voxel_m = 0.0;   ///< > 0: the map is decimated to one point per voxel per keyframe
-  bool realtime = false;      ///< pace the recording at sensor rate
+  bool realtime = false;      ///< replay at sensor rate, dropping scans when behind
+  std::size_t realtime_queue_scans = 2;  ///< scans that may wait before the oldest is dropped
   bool show_progress = true;  ///< a progress line on a terminal
   /// Per-scan boxes around moving parts of the rig (io/moving_boxes.hpp); empty: none.
   std::filesystem::path moving_boxes_file;
+};
+
+/// What a live run would have seen (--realtime): scans dropped because the odometry was behind,
+/// and the latency from a scan's delivery to its pose.
+struct RealtimeReport {
+  std::size_t dropped_scans = 0;
+  double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_max_ms = 0.0;
 };
 
 struct RunSummary {
@@ -42,6 +51,7 @@ struct RunSummary {
   double realtime_factor = 0.0;  ///< recording duration / wall time (> 1: faster than the sensor)
   double peak_memory_mb = 0.0;
   std::string initialization;
+  std::optional<RealtimeReport> realtime;  ///< with --realtime only
 };
 
 /// Runs the odometry over `recording` and writes the outputs into options.out_dir (created).
