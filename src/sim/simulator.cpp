@@ -53,6 +53,10 @@ SimulationSummary writeSimulation(const Simulation& simulation,
   summary.scene = scene.stats();
   summary.min_points_per_scan = std::numeric_limits<std::size_t>::max();
 
+  // Truth that needs no sensor data first, so that a bad georef_epsg fails before the long work.
+  detail::writeGeorefTruthYaml(out_dir / "georef_truth.yaml", simulation);
+  detail::writeTreesCsv(out_dir / "trees.csv", scene);
+  detail::writeScenarioYaml(out_dir / "scenario.yaml", simulation);
   io::BagWriter bag(out_dir / "recording.bag");
   ImuSimulator imu(scenario.imu, simulation.seed(), scenario.gnss.world_yaw_deg);
   GnssSimulator gnss(scenario.gnss, simulation.seed());
@@ -100,9 +104,6 @@ SimulationSummary writeSimulation(const Simulation& simulation,
 
   io::writeTum(out_dir / "groundtruth.tum", ground_truth);
   detail::writeRigYaml(out_dir / "rig.yaml", simulation);
-  detail::writeTreesCsv(out_dir / "trees.csv", scene);
-  detail::writeGeorefTruthYaml(out_dir / "georef_truth.yaml", simulation);
-  detail::writeScenarioYaml(out_dir / "scenario.yaml", simulation);
   summary.simulate_s = secondsSince(start);
   detail::writeSceneJson(out_dir / "scene.json", simulation, summary);
   return summary;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../support/temp_dir.hpp"
+#include "taiga/core/errors.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/geo/coordinates.hpp"
 #include "taiga/io/config_yaml.hpp"
@@ -189,6 +190,20 @@ TEST(TruthOutputs, ScenarioYamlReproducesTheRecording) {
   }
   EXPECT_EQ(imu, 251u);  // 250 Hz over 1 s, both ends
   EXPECT_EQ(with_orientation, imu);
+}
+
+TEST(TruthOutputs, AnUnknownGeorefCodeFailsBeforeTheRecording) {
+  test::TempDir dir;
+  const Simulation simulation(smallScenario("gnss: {georef_epsg: 4326}\n"), 0.5, 2);
+  try {
+    writeSimulation(simulation, dir.path());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("EPSG:4326: 'WGS 84' is not a projected CRS"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("recording.bag")));
 }
 
 }  // namespace

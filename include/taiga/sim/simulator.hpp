@@ -7,7 +7,8 @@
 //   rig.yaml           the configuration `taiga run` uses for this recording
 //   scene.json         scenario, seed, georeference of the world frame, every stem's truth
 //   trees.csv          one row per stem: base position, DBH, height, lean, species
-//   georef_truth.yaml  the world frame in EPSG:3067 (origin, rotation, scale, T_epsg_world)
+//   georef_truth.yaml  the world frame in EPSG:3067 (origin, rotation, scale, T_epsg_world);
+//                      written first: an unknown gnss.georef_epsg fails before the recording
 //   scenario.yaml      the effective scenario (taiga simulate --overrides scenario.yaml redoes it)
 
 #include <cstdint>
