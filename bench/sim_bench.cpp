@@ -12,9 +12,9 @@
 // depends on what else runs, while CPU-seconds per data-second is what real time needs on an idle
 // machine (<= 1 at one thread, <= 2 at two threads with perfect scaling).
 //
-//   sim_bench [RUNS] [DURATION_S] [SCENARIO] [SEED]   (defaults 3, 10, mixed, 1; run from the
-//                                                      repository root: the simulator reads
-//                                                      ../shared/data/ouster)
+//   sim_bench [RUNS] [DURATION_S] [SCENARIO] [SEED] [SUB_RAYS]
+//     (defaults 3, 10, mixed, 1, the scenario's 4; run from the repository root: the simulator
+//      reads ../shared/data/ouster)
 #include <sys/resource.h>
 #include <tbb/task_arena.h>
 
@@ -68,11 +68,13 @@ int main(int argc, char** argv) {
   const std::string scenario_name = argc > 3 ? argv[3] : "mixed";
   const std::uint64_t seed = argc > 4 ? std::strtoull(argv[4], nullptr, 10) : 1;
   if (runs < 1 || duration_s <= 0.0) {
-    std::fprintf(stderr, "usage: sim_bench [RUNS>=1] [DURATION_S>0] [SCENARIO] [SEED]\n");
+    std::fprintf(stderr,
+                 "usage: sim_bench [RUNS>=1] [DURATION_S>0] [SCENARIO] [SEED] [SUB_RAYS]\n");
     return 2;
   }
 
-  const taiga::sim::Scenario scenario = taiga::sim::scenarioByName(scenario_name);
+  taiga::sim::Scenario scenario = taiga::sim::scenarioByName(scenario_name);
+  if (argc > 5) scenario.lidar.sub_rays = std::atoi(argv[5]);
   std::unique_ptr<taiga::sim::Simulation> simulation;
   const Timing build = timed([&] {
     simulation = std::make_unique<taiga::sim::Simulation>(scenario, duration_s, seed);
