@@ -26,6 +26,10 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.field("min_range_m", min_range_m, "m, returns closer to the lidar are dropped (operator, rig)");
   v.field("max_range_m", max_range_m, "m, returns farther from the lidar are dropped");
   v.field("voxel_size_m", voxel_size_m, "m, voxel filter of the scan registered to the local map");
+  static constexpr std::array<std::string_view, 3> kImuUses{"auto", "lidar_inertial", "lidar_only"};
+  v.choice("imu_use", imu_use, kImuUses,
+           "lidar_only: constant-velocity prediction and deskew, no IMU; auto: lidar_only when no IMU "
+           "reading comes within the first 2 s of scans");
   static constexpr std::array<std::string_view, 3> kMethods{"ndt", "d2d", "gicp"};
   v.choice("method", method, kMethods,
            "scan-to-map registration: ndt, d2d (distribution-to-distribution) or gicp");

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -189,6 +190,34 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
     }
     return true;
   };
+  // Lidar-only when configured, or (auto) when no IMU reading comes with the first 2 s of scans:
+  // those events are read ahead, then handled first (without pacing under --realtime).
+  std::deque<io::RecordingEvent> read_ahead;
+  bool lidar_only = config.odometry.imu_use == "lidar_only";
+  if (config.odometry.imu_use == "auto") {
+    constexpr double kImuWait_s = 2.0;
+    std::optional<double> first_scan_s;
+    while (std::optional<io::RecordingEvent> event = recording.next()) {
+      read_ahead.push_back(std::move(*event));
+      if (std::holds_alternative<ImuSample>(read_ahead.back())) break;
+      if (!std::holds_alternative<io::Scan>(read_ahead.back())) continue;
+      const double t_s = io::eventTime(read_ahead.back());
+      if (!first_scan_s) first_scan_s = t_s;
+      if (t_s - *first_scan_s >= kImuWait_s) {
+        lidar_only = true;
+        break;
+      }
+    }
+  }
+  if (lidar_only) {
+    logger().info("lidar-only odometry{}: constant-velocity prediction and deskew, world frame = "
+                  "the first scan's body frame (not levelled)",
+                  config.odometry.imu_use == "auto" ? " (no IMU reading with the first 2 s of scans)"
+                                                    : "");
+  }
+  odometry.setLidarOnly(lidar_only);
+  for (const io::RecordingEvent& event : read_ahead) handle(event);
+  read_ahead.clear();
   if (options.realtime) {
     std::vector<double> latencies_ms;
     RealtimeFeed feed(recording, options.realtime_queue_scans);
@@ -215,7 +244,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   if (trajectory.empty()) {
     throw InputError(
         fmt::format("{}: no scan could be processed ({} scans, {} IMU samples): the odometry needs "
-                    "scans with per-point times and at least 0.5 s of IMU readings before them",
+                    "at least 0.5 s of IMU readings before the scans, or odometry.imu_use: "
+                    "lidar_only",
                     recording_path.string(), summary.scans, summary.imu_samples));
   }
   io::writeTum(options.out_dir / "trajectory.tum", trajectory);

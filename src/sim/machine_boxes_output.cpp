@@ -36,9 +36,9 @@ std::string cabinBoxRigComment() {
   const Eigen::Vector3d lo = cabin.center - cabin.half_extents, hi = cabin.center + cabin.half_extents;
   return fmt::format(
       "# Harvester: the cabin is a fixed box in the body frame (m), returns from it are the machine:\n"
-      "#   min ({:.2f}, {:.2f}, {:.2f}) max ({:.2f}, {:.2f}, {:.2f}); grown by {:.2f} m it is box_id 0 of\n"
-      "#   machine_boxes.csv, which also holds the moving crane's boxes per scan. (The configuration\n"
-      "#   has no crop-box field yet, so the box is given here as a comment.)\n",
+      "#   min ({:.2f}, {:.2f}, {:.2f}) max ({:.2f}, {:.2f}, {:.2f}); grown by {:.2f} m it is\n"
+      "#   rig.self_boxes_body below and box_id 0 of machine_boxes.csv, which also holds the moving\n"
+      "#   crane's boxes per scan (taiga run --moving-boxes machine_boxes.csv).\n",
       lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), kMachineBoxMargin_m);
 }
 

@@ -56,7 +56,12 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
       imu.accel_bias_random_walk, imu.accel_turn_on_bias, imu.gyro_noise_density,
       imu.gyro_bias_random_walk, imu.gyro_turn_on_bias, lidar.range_noise_m,
       lidar.range_noise_per_m, lidar.beam_divergence_deg);
-  if (simulation.motion().machine()) header += cabinBoxRigComment();
+  if (simulation.motion().machine()) {
+    header += cabinBoxRigComment();
+    const OrientedBox cabin = HarvesterMachine::cabinInBody();  // axis-aligned in the body frame
+    const Eigen::Vector3d grown = cabin.half_extents.array() + kMachineBoxMargin_m;
+    config.rig.self_boxes_body = {{cabin.center - grown, cabin.center + grown}};
+  }
   writeText(path, header + io::writeConfigYaml(config));
 }
 

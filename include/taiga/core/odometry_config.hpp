@@ -25,6 +25,9 @@ struct OdometryConfig final : ConfigSection {
   double max_range_m = 80.0;
   double voxel_size_m = 0.4;  ///< voxel filter of the registration source
   // Registration to the local map.
+  /// auto | lidar_inertial | lidar_only. auto: lidar-only when the recording has delivered no
+  /// IMU reading within its first 2 s of scans.
+  std::string imu_use = "auto";
   std::string method = "ndt";  ///< ndt | d2d | gicp
   double ndt_resolution_m = 1.0;
   std::string ndt_neighbours = "direct1";  ///< direct1 | direct7: NDT cells scored per point

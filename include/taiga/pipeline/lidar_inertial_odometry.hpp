@@ -85,8 +85,13 @@ class LidarInertialOdometry {
   /// Boxes around moving parts of the rig (a harvester's boom), per scan, in the body frame:
   /// returns inside the boxes of a scan's time span are dropped.
   void setMovingBoxes(MovingBoxes boxes_body) { moving_boxes_body_ = std::move(boxes_body); }
+  /// Without an IMU: each scan is predicted and deskewed with the constant velocity of the last
+  /// two poses and registered to the local map; the world frame is the first scan's body frame
+  /// (not levelled). Set before the first scan.
+  void setLidarOnly(bool lidar_only) { lidar_only_ = lidar_only; }
+  bool lidarOnly() const { return lidar_only_; }
 
-  bool initialized() const { return smoother_.initialized(); }
+  bool initialized() const { return lidar_only_ || smoother_.initialized(); }
   /// The first scan's outcome (its state and keyframe), once, after the scan that initialized.
   std::optional<ScanOutcome> takeFirstOutcome() {
     return std::exchange(first_outcome_, std::nullopt);
@@ -97,14 +102,15 @@ class LidarInertialOdometry {
 
  private:
   void initialize(const io::Scan& first, const io::Scan& second);
+  std::optional<ScanOutcome> addScanLidarOnly(const io::Scan& scan);
   /// The scan's returns within the range limits and outside the rig's boxes, in the lidar frame.
   PointCloud forestPointsInLidar(const io::Scan& scan) const;
   PointCloud deskewScan(const io::Scan& scan, const imu::NavState& state_prev, double t_prev,
                         const imu::ImuBias& bias, std::vector<StampedPose>* imu_rate_poses);
   registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
                                                  const lie::SE3& guess_T_world_body);
-  std::optional<backend::PoseMeasurement> judge(ScanOutcome& outcome,
-                                                const lie::SE3& predicted) const;
+  std::optional<backend::PoseMeasurement> judge(ScanOutcome& outcome, const lie::SE3& predicted,
+                                                bool check_jump = true) const;
   void maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body);
   void collectForAlignment(const ScanOutcome& outcome, const imu::Preintegrator* increment);
   void levelWorld(ScanOutcome& outcome);
@@ -114,6 +120,14 @@ class LidarInertialOdometry {
   RigConfig rig_;
   std::vector<OrientedBox> self_boxes_lidar_;  ///< rig.self_boxes_body in the lidar frame
   MovingBoxes moving_boxes_body_;
+  bool lidar_only_ = false;
+  /// Lidar-only: the last pose and the body-frame twist per second that predicts the next.
+  struct ConstantVelocity {
+    double t_s = 0.0;
+    lie::SE3 T_world_body;
+    lie::Vector6 twist_per_s = lie::Vector6::Zero();
+  };
+  std::optional<ConstantVelocity> constant_velocity_;
   Eigen::Vector3d gravity_world_;
   ImuBuffer imu_;
   backend::OdometrySmoother smoother_;
