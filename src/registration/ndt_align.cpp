@@ -13,6 +13,7 @@ namespace {
 
 constexpr std::size_t kMinSourcePoints = 10;
 constexpr int kMaxLineSearchSteps = 10;
+constexpr double kRotationLever_m = 5.0;
 
 using Evaluate = std::function<NdtDerivatives(const lie::SE3&, bool)>;
 
@@ -36,8 +37,13 @@ RegistrationResult newton(const Evaluate& evaluate, const lie::SE3& guess, const
   for (int it = 1; it <= config.max_iterations && !small_step; ++it) {
     if (D.num_inliers == 0) break;
     lie::Vector6 step = newtonStep(D.hessian, D.gradient);
-    const double step_m = step.head<3>().norm();
-    if (step_m > max_step_m) step *= max_step_m / step_m;
+    // The step is shortened (direction kept) to at most max_step_m of translation and to a
+    // rotation that moves a point kRotationLever_m away by no more than that. Far from the
+    // optimum the modified Newton step of this non-convex score can turn by tens of degrees; the
+    // line search would then halve it several times, each halving a pass over the scan.
+    const double shrink = std::max({1.0, step.head<3>().norm() / max_step_m,
+                                    step.tail<3>().norm() * kRotationLever_m / max_step_m});
+    step /= shrink;
     result.iterations = it;
     if (step.head<3>().norm() < config.step_epsilon_m &&
         step.tail<3>().norm() < config.step_epsilon_rad) {
