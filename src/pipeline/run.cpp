@@ -92,6 +92,25 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
   openOutput(path) << j.dump(2) << "\n";
 }
 
+// Lidar-only when configured so, or (auto) when no IMU reading comes with the first 2 s of
+// scans. The events read to decide are left in `read_ahead`, to be handled first (without
+// pacing under --realtime).
+bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
+                  std::deque<io::RecordingEvent>& read_ahead) {
+  if (imu_use != "auto") return imu_use == "lidar_only";
+  constexpr double kImuWait_s = 2.0;
+  std::optional<double> first_scan_s;
+  while (std::optional<io::RecordingEvent> event = recording.next()) {
+    read_ahead.push_back(std::move(*event));
+    if (std::holds_alternative<ImuSample>(read_ahead.back())) return false;
+    if (!std::holds_alternative<io::Scan>(read_ahead.back())) continue;
+    const double t_s = io::eventTime(read_ahead.back());
+    if (!first_scan_s) first_scan_s = t_s;
+    if (t_s - *first_scan_s >= kImuWait_s) return true;
+  }
+  return false;  // too short to tell: the odometry will say what it lacks
+}
+
 }  // namespace
 
 RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& config,
@@ -190,25 +209,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
     }
     return true;
   };
-  // Lidar-only when configured, or (auto) when no IMU reading comes with the first 2 s of scans:
-  // those events are read ahead, then handled first (without pacing under --realtime).
   std::deque<io::RecordingEvent> read_ahead;
-  bool lidar_only = config.odometry.imu_use == "lidar_only";
-  if (config.odometry.imu_use == "auto") {
-    constexpr double kImuWait_s = 2.0;
-    std::optional<double> first_scan_s;
-    while (std::optional<io::RecordingEvent> event = recording.next()) {
-      read_ahead.push_back(std::move(*event));
-      if (std::holds_alternative<ImuSample>(read_ahead.back())) break;
-      if (!std::holds_alternative<io::Scan>(read_ahead.back())) continue;
-      const double t_s = io::eventTime(read_ahead.back());
-      if (!first_scan_s) first_scan_s = t_s;
-      if (t_s - *first_scan_s >= kImuWait_s) {
-        lidar_only = true;
-        break;
-      }
-    }
-  }
+  const bool lidar_only = useLidarOnly(recording, config.odometry.imu_use, read_ahead);
   if (lidar_only) {
     logger().info("lidar-only odometry{}: constant-velocity prediction and deskew, world frame = "
                   "the first scan's body frame (not levelled)",
