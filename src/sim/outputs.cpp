@@ -16,12 +16,6 @@
 namespace taiga::sim::detail {
 namespace {
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-
-void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) throw std::runtime_error(fmt::format("{}: cannot write", path.string()));
-}
 }  // namespace
 
 void writeRigYaml(const std::filesystem::path& path, const Simulation& simulation) {

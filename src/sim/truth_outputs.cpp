@@ -14,13 +14,13 @@
 namespace taiga::sim {
 namespace {
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+}  // namespace
 
-void writeText(const std::filesystem::path& path, const std::string& text) {
+void detail::writeText(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path);
   out << text;
   if (!out) throw std::runtime_error(fmt::format("{}: cannot write", path.string()));
 }
-}  // namespace
 
 GeorefTruth georefTruth(const GnssParams& gnss) {
   const geo::CoordinateConverter converter(gnss.georef_epsg);

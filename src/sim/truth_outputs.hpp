@@ -3,12 +3,16 @@
 // effective scenario.yaml (docs/simulator.md, "Outputs").
 
 #include <filesystem>
+#include <string>
 
 #include "taiga/sim/simulator.hpp"
 
 namespace taiga::sim::detail {
 
 const char* speciesName(Species species);
+
+/// Writes `text` to `path`; std::runtime_error naming the file when it cannot.
+void writeText(const std::filesystem::path& path, const std::string& text);
 
 /// One row per stem: id, base position in the world frame, DBH, height, lean, species.
 void writeTreesCsv(const std::filesystem::path& path, const Scene& scene);
