@@ -1,6 +1,6 @@
 #pragma once
 // Geometry of a scene as flat buffers in Embree's layouts: triangles (float3 vertices, uint3
-// indices) and round linear curves (float4 x y z radius vertices, one uint index per segment).
+// indices) and cone linear curves (float4 x y z radius vertices, one uint index per segment).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

@@ -16,6 +16,7 @@
 #include "taiga/core/log.hpp"
 #include "taiga/io/ouster/sensor_info.hpp"
 #include "taiga/sim/machine.hpp"
+#include "ring_on_curve.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim {
@@ -27,6 +28,12 @@ constexpr int kMaxSubRays = 8;
 constexpr double kNoHit = std::numeric_limits<double>::infinity();
 /// Reflectivity of the target that reaches max_range_m at normal incidence.
 constexpr double kReferenceReflectivity = 0.8;
+/// Beyond this margin past the detection limit of the brightest material a hit cannot change a
+/// return (a mixed range averages echoes less than 1 m apart), m.
+constexpr double kMixingMargin_m = 1.0;
+/// The ring rays start this far in front of the nearest centre hit among the pixel and its two
+/// azimuth neighbours, m.
+constexpr double kRingLead_m = 0.5;
 
 /// One pixel's outcome before compaction.
 struct Pixel {
@@ -34,6 +41,16 @@ struct Pixel {
   Eigen::Vector3f p_sensor = Eigen::Vector3f::Zero();
   float intensity = 0.0f;
 };
+
+/// The highest reflectivity of any scene material.
+double maxReflectivity() {
+  double best = 0.0;
+  for (const Material m : {Material::kGround, Material::kBark, Material::kBranch,
+                           Material::kFoliage, Material::kRock, Material::kDeadWood,
+                           Material::kMachine})
+    best = std::max(best, reflectivity(m));
+  return best;
+}
 
 struct SubHit {
   double range_m;
@@ -123,6 +140,15 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   const double center_weight = k_rays == 1 ? 1.0 : 0.4;
   const double ring_weight = k_rays == 1 ? 0.0 : 0.6 / (k_rays - 1);
 
+  // Rays end where nothing could be detected any more: the range limit of the brightest material
+  // at normal incidence with the whole footprint on it (the detection rule below), plus the
+  // mixing margin. A hit beyond would be dropped anyway; as the far echo of an edge it could only
+  // outweigh a detectable near one, which a real receiver would not do for an echo too weak to
+  // detect. (The ray used to run on to 1.2 x max_range_m: about 8 % slower, sim_bench.)
+  const double t_max_m =
+      params_.max_range_m * std::sqrt(maxReflectivity() / kReferenceReflectivity) +
+      kMixingMargin_m;
+
   // Pass 1: the centre ray of every pixel, each column from the true pose at its firing time.
   struct Column {
     Eigen::Matrix3d R_world_lidar;
@@ -133,6 +159,7 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   std::vector<Column> columns(cols);
   std::vector<SubHit> centers(pixels.size(), SubHit{kNoHit, 0.0, 0.0});
   std::vector<std::uint8_t> solid(pixels.size(), 0);
+  std::vector<std::int32_t> segment(pixels.size(), -1);  ///< curve segment of the centre hit
   auto direction = [&](int col, int row) -> const Eigen::Vector3d& {
     return directions_lidar_[static_cast<std::size_t>(col) * rows + row];
   };
@@ -153,11 +180,11 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
                               geometry_.beam_origin_z_m);
           c.origin_world = T_world_lidar * c.origin_lidar;
           for (int row = 0; row < rows; ++row) dirs[row] = c.R_world_lidar * direction(col, row);
-          scene.castRays(c.origin_world, dirs, params_.max_range_m * 1.2,
+          scene.castRays(c.origin_world, dirs, t_max_m,
                          column_hits);  // packets of 16
           if (machine) {  // the machine's own body: nearest hit wins
             c.machine = machine->snapshot(t, T_world_body);
-            c.machine->occlude(c.origin_world, dirs, params_.max_range_m * 1.2, column_hits);
+            c.machine->occlude(c.origin_world, dirs, t_max_m, column_hits);
           }
           for (int row = 0; row < rows; ++row) {
             const auto& hit = column_hits[row];
@@ -166,12 +193,13 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
             const std::size_t pixel = static_cast<std::size_t>(col) * rows + row;
             centers[pixel] = {hit->range_m, 1.0, reflectivity(hit->material) * cos_inc};
             solid[pixel] = hit->material != Material::kFoliage ? 1 : 0;
+            segment[pixel] = hit->curve_segment;
           }
         }
       });
 
   // Pass 2: where the centre ranges of neighbouring pixels jump (an edge), the beam footprint
-  // straddles several surfaces: cast the sub-rays of the ring and mix. Elsewhere the footprint
+  // may straddle several surfaces: cast the sub-rays of the ring and mix. Elsewhere the footprint
   // lies on one surface and the centre ray stands for it.
   auto rangeAt = [&](int col, int row) {
     return centers[static_cast<std::size_t>((col + cols) % cols) * rows + row].range_m;
@@ -183,31 +211,64 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   auto solidAt = [&](int col, int row) {
     return solid[static_cast<std::size_t>((col + cols) % cols) * rows + row] != 0;
   };
-  auto isEdge = [&](int col, int row) {
+  auto segmentAt = [&](int col, int row) {
+    return segment[static_cast<std::size_t>((col + cols) % cols) * rows + row];
+  };
+  // Half-angle tangent of the ring: a ring ray is tan_ring * t off the centre ray at range t.
+  const double tan_ring = std::tan(ring_rad);
+  // Whether pixel (col, row), whose centre ray leaves origin_world along d_world, needs its ring.
+  // A range jump to an azimuth neighbour flags a possible edge; when the nearer side of the jump
+  // is a curve (stem, branch, twig: most edges in a forest), the cone's geometry settles it
+  // exactly and cheaply (ring_on_curve.hpp): the ring is cast only if it can cross the curve's
+  // silhouette. The neighbours are a column (0.35 deg) apart and the ring only 0.13 deg off the
+  // centre, so this skips about half of the flagged pixels (46 % -> 22 % of all pixels in the
+  // mixed stand), whose ring would have returned the centre's surface anyway.
+  auto needsRing = [&](int col, int row, const Eigen::Vector3d& origin_world,
+                       const Eigen::Vector3d& d_world) {
     const double r = rangeAt(col, row);
     for (const int nb : {col - 1, col + 1}) {
       const double q = rangeAt(nb, row);
       if (q == r) continue;
       const bool near_is_self = r < q;
       if (!(near_is_self ? solidAt(col, row) : solidAt(nb, row))) continue;
-      if (q == kNoHit || r == kNoHit || std::abs(q - r) > 0.15 + 0.01 * std::min(r, q)) return true;
+      if (!(q == kNoHit || r == kNoHit || std::abs(q - r) > 0.15 + 0.01 * std::min(r, q)))
+        continue;
+      const std::int32_t near_segment = near_is_self ? segmentAt(col, row) : segmentAt(nb, row);
+      if (near_segment < 0) return true;  // a triangle (ground, rock): cast
+      const bool settled = near_is_self ? detail::ringStaysOnCurve(scene, near_segment, origin_world,
+                                                           d_world, r, tan_ring)
+                                        : detail::ringMissesCurve(scene, near_segment, origin_world,
+                                                          d_world, tan_ring);
+      if (!settled) return true;
     }
     return false;
   };
   tbb::parallel_for(tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>&
                                                                   range) {
     std::array<SubHit, kMaxSubRays> hits{};
+    std::vector<int> ring_rows;
+    std::vector<Eigen::Vector3d> ring_dirs;
+    std::vector<double> ring_t_min;
+    std::vector<std::optional<RayHit>> ring_hits;
     for (int col = range.begin(); col != range.end(); ++col) {
       const Column& c = columns[col];
-      for (int row = 0; row < rows; ++row) {
-        const std::uint64_t pixel_id = static_cast<std::uint64_t>(col) * rows + row;
-        const Eigen::Vector3d d_lidar = direction(col, row);
-        const SubHit& center = centers[pixel_id];
-        int n_hits = 0;
-        if (k_rays > 1 && isEdge(col, row)) {
-          if (center.range_m != kNoHit)
-            hits[n_hits++] = {center.range_m, center_weight, center.reflectivity_eff};
-          const Eigen::Vector3d d_world = c.R_world_lidar * d_lidar;
+      // The ring rays of every pixel of the column that needs them, cast together in packets
+      // of 16 (Embree rtcIntersect16; about twice as fast as one rtcIntersect1 per ray).
+      ring_rows.clear();
+      ring_dirs.clear();
+      ring_t_min.clear();
+      if (k_rays > 1) {
+        for (int row = 0; row < rows; ++row) {
+          const std::uint64_t pixel_id = static_cast<std::uint64_t>(col) * rows + row;
+          const Eigen::Vector3d d_world = c.R_world_lidar * direction(col, row);
+          if (!needsRing(col, row, c.origin_world, d_world)) continue;
+          ring_rows.push_back(row);
+          // The ring looks for the surfaces the centre rays around it found: it starts just in
+          // front of the nearest of them (a thin object in front of all three centre rays is
+          // missed, as it is by a pixel that is not at an edge). About 9 % faster (sim_bench).
+          double nearest_m = rangeAt(col, row);
+          for (const int nb : {col - 1, col + 1}) nearest_m = std::min(nearest_m, rangeAt(nb, row));
+          const double ring_t_min_m = std::max(0.0, nearest_m - kRingLead_m);
           const Eigen::Vector3d e1 =
               d_world
                   .cross(std::abs(d_world.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
@@ -217,14 +278,33 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
           const double spin = 2.0 * kPi * hashUniform(seed_, index, pixel_id, 101);
           for (int k = 1; k < k_rays; ++k) {
             const double a = spin + 2.0 * kPi * (k - 1) / (k_rays - 1);
-            const Eigen::Vector3d dir =
-                (d_world + std::tan(ring_rad) * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
-            auto hit = scene.castRay(c.origin_world, dir, 0.0, params_.max_range_m * 1.2);
-            if (c.machine) c.machine->occlude(c.origin_world, dir, params_.max_range_m * 1.2, hit);
+            ring_dirs.push_back(
+                (d_world + tan_ring * (std::cos(a) * e1 + std::sin(a) * e2)).normalized());
+            ring_t_min.push_back(ring_t_min_m);
+          }
+        }
+        if (!ring_dirs.empty()) {
+          scene.castRays(c.origin_world, ring_dirs, t_max_m, ring_hits, &ring_t_min);
+          if (c.machine) c.machine->occlude(c.origin_world, ring_dirs, t_max_m, ring_hits);
+        }
+      }
+      std::size_t next_ring = 0;
+      for (int row = 0; row < rows; ++row) {
+        const std::uint64_t pixel_id = static_cast<std::uint64_t>(col) * rows + row;
+        const Eigen::Vector3d d_lidar = direction(col, row);
+        const SubHit& center = centers[pixel_id];
+        int n_hits = 0;
+        if (next_ring < ring_rows.size() && ring_rows[next_ring] == row) {
+          if (center.range_m != kNoHit)
+            hits[n_hits++] = {center.range_m, center_weight, center.reflectivity_eff};
+          for (int k = 1; k < k_rays; ++k) {
+            const std::size_t ray = next_ring * static_cast<std::size_t>(k_rays - 1) + (k - 1);
+            const auto& hit = ring_hits[ray];
             if (!hit) continue;
-            const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(dir)));
+            const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(ring_dirs[ray])));
             hits[n_hits++] = {hit->range_m, ring_weight, reflectivity(hit->material) * cos_inc};
           }
+          ++next_ring;
         } else if (center.range_m != kNoHit) {
           hits[n_hits++] = center;  // weight 1: the whole footprint on one surface
         }

@@ -3,7 +3,7 @@
 //
 // The plot is an axis-aligned square in the world frame (x east, y north, z up). Its geometry:
 // - ground: a triangle mesh (0.5 m grid) of Terrain::height, micro-relief included;
-// - stems, branches, twigs, sapling stems and fallen logs: Embree round linear curves (chains of
+// - stems, branches, twigs, sapling stems and fallen logs: Embree cone linear curves (chains of
 //   cones with a radius per vertex);
 // - needles and leaves: many small triangles around the branches, shrubs as clumps of triangles;
 // - boulders: perturbed, half-buried icospheres.
@@ -75,6 +75,18 @@ struct RayHit {
   double range_m = 0.0;          ///< distance along the (unit) ray direction, m
   Eigen::Vector3d normal_world;  ///< unit surface normal facing the ray origin
   Material material = Material::kGround;
+  /// Index of the curve segment hit (for Scene::curveSegment), or -1 for a triangle or anything
+  /// that is not part of the scene (the harvester's own body).
+  std::int32_t curve_segment = -1;
+};
+
+/// One cone of a linear curve (stem, branch, twig, sapling, log): the axis from a to b
+/// with the radius interpolated linearly from radius_a to radius_b.
+struct CurveSegment {
+  Eigen::Vector3d a_world, b_world;
+  double radius_a_m = 0.0, radius_b_m = 0.0;
+  bool continues_before = false;  ///< the chain goes on beyond a (a is not a free end)
+  bool continues_after = false;   ///< the chain goes on beyond b
 };
 
 struct SceneStats {
@@ -98,15 +110,20 @@ class Scene {
                                 double t_max_m) const;
 
   /// Nearest hits of rays that share an origin (e.g. one lidar column), in packets of 16
-  /// (Embree rtcIntersect16): hits[i] for directions[i]. Same results as castRay. Thread-safe.
+  /// (Embree rtcIntersect16): hits[i] for directions[i], searched from (*t_min_m)[i] (0 when
+  /// t_min_m is null) to t_max_m. Same results as castRay. Thread-safe.
   void castRays(const Eigen::Vector3d& origin_world,
                 const std::vector<Eigen::Vector3d>& directions_world, double t_max_m,
-                std::vector<std::optional<RayHit>>& hits) const;
+                std::vector<std::optional<RayHit>>& hits,
+                const std::vector<double>* t_min_m = nullptr) const;
 
   /// Unsigned distance from a point to the nearest scene surface, m, or max_distance_m when
-  /// nothing is closer. Curves count as cones (radius interpolated along each segment).
-  /// Thread-safe.
+  /// nothing is closer. Curves count as cones (radius interpolated along each segment) closed
+  /// by flat end discs, as Embree casts them. Thread-safe.
   double distanceToSurface(const Eigen::Vector3d& p_world, double max_distance_m = 5.0) const;
+
+  /// The curve segment with the given index (RayHit::curve_segment); index must be valid.
+  CurveSegment curveSegment(std::int32_t index) const;
 
   const Terrain& terrain() const;
   const SceneLayout& layout() const;
