@@ -1,14 +1,18 @@
 // taiga eval: trajectory accuracy metrics (docs/evaluation.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <optional>
 
 #include "command.hpp"
+#include "simulated_scene.hpp"
 #include "taiga/core/errors.hpp"
+#include "taiga/eval/map_sharpness.hpp"
 #include "taiga/eval/plot.hpp"
 #include "taiga/eval/report.hpp"
+#include "taiga/io/las_reader.hpp"
 #include "taiga/io/trajectory_io.hpp"
 
 namespace taiga::app {
@@ -28,7 +32,25 @@ struct EvalOptions {
   double distance_bin_m = 0.1;
   bool json = false;
   bool markdown = false;
+  std::string map, scene;
+  double map_cap_m = 1.0;
+  std::size_t map_points = 200000;
 };
+
+// Map sharpness: an evenly strided subsample of the map, moved into the truth frame with the
+// trajectory's alignment, against the regenerated scene.
+eval::MapSharpness mapSharpness(const EvalOptions& options, const eval::AlignmentTransform& T) {
+  io::LasReader reader(options.map);
+  const std::uint64_t stride =
+      std::max<std::uint64_t>(1, (reader.pointCount() + options.map_points - 1) / options.map_points);
+  const PointCloud sample = reader.readStrided(stride);
+  const sim::Simulation simulation = simulationOfRecording(options.scene);
+  const sim::Scene& scene = simulation.scene();
+  return eval::computeMapSharpness(
+      sample.positions, reader.pointCount(), T,
+      [&](const Eigen::Vector3d& p_ref, double max_m) { return scene.distanceToSurface(p_ref, max_m); },
+      {.cap_m = options.map_cap_m, .max_points = options.map_points});
+}
 
 int runEval(const EvalOptions& options) {
   eval::EvalReport report;
@@ -50,6 +72,14 @@ int runEval(const EvalOptions& options) {
   } catch (const InputError& e) {
     throw InputError(
         fmt::format("{} against {}: {}", options.estimate, options.reference, e.what()));
+  }
+  if (!options.map.empty() || !options.scene.empty()) {
+    if (options.map.empty() || options.scene.empty())
+      throw InputError("--map and --scene go together: the map and the simulated recording whose "
+                       "scene it is scored against");
+    report.map_file = options.map;
+    report.scene_dir = options.scene;
+    report.map_sharpness = mapSharpness(options, report.result.transform);
   }
   if (!options.timing.empty()) {
     report.timing_file = options.timing;
@@ -121,6 +151,19 @@ Command addEvalCommand(CLI::App& tool) {
   parser->add_flag("--distance", options->distance,
                    "Show the distance distribution between the two trajectories (unaligned)");
   parser->add_option("--distance-bin-m", options->distance_bin_m, "Histogram bin width, m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  parser->add_option("--map", options->map,
+                     "map.las of the run: score its distance to the true scene (with --scene)")
+      ->check(CLI::ExistingFile);
+  parser->add_option("--scene", options->scene,
+                     "Directory written by taiga simulate (scenario.yaml, scene.json) whose scene "
+                     "the map is scored against")
+      ->check(CLI::ExistingDirectory);
+  parser->add_option("--map-cap", options->map_cap_m, "Map distances are capped here, m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  parser->add_option("--map-points", options->map_points, "Score at most this many map points")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   parser->add_flag("--json", options->json, "Print JSON instead of text");

@@ -38,5 +38,6 @@ Command addEvalCommand(CLI::App& tool);
 Command addCompareCommand(CLI::App& tool);
 Command addGeorefCommand(CLI::App& tool);
 Command addConfigCommand(CLI::App& tool);
+Command addExportMapCommand(CLI::App& tool);
 
 }  // namespace taiga::app

@@ -33,7 +33,8 @@ int runTool(int argc, char** argv) {
   const std::vector<Command> commands{
       addSimulateCommand(tool), addInfoCommand(tool),   addExportCommand(tool),
       addRegisterCommand(tool), addRunCommand(tool),    addEvalCommand(tool),
-      addCompareCommand(tool),  addGeorefCommand(tool), addConfigCommand(tool)};
+      addCompareCommand(tool),  addGeorefCommand(tool), addConfigCommand(tool),
+      addExportMapCommand(tool)};
 
   try {
     tool.parse(argc, argv);

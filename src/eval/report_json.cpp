@@ -58,6 +58,19 @@ std::string formatEvalJson(const EvalReport& report) {
                    {"first_bin_start_m", d.first_bin_start_m},
                    {"counts", d.counts}};
   if (report.timing) j["timing"] = detail::timingJson(*report.timing, report.timing_file);
+  if (report.map_sharpness) {
+    const MapSharpness& m = *report.map_sharpness;
+    j["map_sharpness"] = {{"map", report.map_file},
+                          {"scene", report.scene_dir},
+                          {"map_points", m.map_points},
+                          {"points_scored", m.points_scored},
+                          {"cap_m", m.cap_m},
+                          {"rms_m", m.rms_m},
+                          {"mean_m", m.mean_m},
+                          {"median_m", m.median_m},
+                          {"p95_m", m.p95_m},
+                          {"fraction_beyond_cap", m.fraction_beyond_cap}};
+  }
   return detail::dump(j);
 }
 

@@ -81,6 +81,16 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
                       fmt::format("{}", d.counts[k])});
     }
   }
+  if (report.map_sharpness) {
+    const MapSharpness& m = *report.map_sharpness;
+    rows.push_back({"Map sharpness RMS (m)",
+                    fmt::format("{:.6f} ({} of {} points of {}, distances capped at {} m)",
+                                m.rms_m, m.points_scored, m.map_points, report.map_file, m.cap_m)});
+    rows.push_back({"Map distance to true surfaces (m)",
+                    fmt::format("mean {:.6f}  median {:.6f}  p95 {:.6f}  beyond {} m: {:.3f} %",
+                                m.mean_m, m.median_m, m.p95_m, m.cap_m,
+                                100.0 * m.fraction_beyond_cap)});
+  }
   if (report.timing) {
     const TimingStatistics& t = *report.timing;
     for (const StageTiming& s : t.stages)

@@ -18,10 +18,10 @@
 #include "taiga/core/progress.hpp"
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/io/moving_boxes.hpp"
-#include "taiga/io/las_writer.hpp"
 #include "taiga/io/trajectory_io.hpp"
+#include "taiga/mapping/keyframe_store.hpp"
+#include "taiga/mapping/map_export.hpp"
 #include "taiga/pipeline/lidar_inertial_odometry.hpp"
-#include "taiga/preprocess/voxel_filter.hpp"
 
 namespace taiga::pipeline {
 namespace {
@@ -78,6 +78,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"time_per_scan_ms",
        {{"mean", s.mean_ms}, {"p50", s.median_ms}, {"p95", s.p95_ms}, {"max", s.max_ms}}},
       {"wall_time_s", s.wall_time_s},
+      {"map_export_s", s.map_export_s},
       {"realtime_factor", s.realtime_factor},
       {"peak_memory_mb", s.peak_memory_mb},
       {"initialization", s.initialization},
@@ -111,6 +112,20 @@ bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
   return false;  // too short to tell: the odometry will say what it lacks
 }
 
+std::vector<lie::SE3> transformedPoses(const std::vector<lie::SE3>& poses, const lie::SE3& T_new_old) {
+  std::vector<lie::SE3> out;
+  out.reserve(poses.size());
+  for (const lie::SE3& T_old_body : poses) out.push_back(T_new_old * T_old_body);
+  return out;
+}
+
+// The one place that decides which keyframe poses the outputs (map.las, keyframes.tum,
+// keyframes/poses.tum) are built from. Today: the odometry's poses at the keyframes, re-expressed
+// in the levelled world frame. The mapping graph (issue 7) puts its optimized poses here.
+std::vector<lie::SE3> finalKeyframePoses(const mapping::KeyframeStore& keyframe_store) {
+  return keyframe_store.poses();
+}
+
 }  // namespace
 
 RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& config,
@@ -135,16 +150,11 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   std::ofstream scans = openOutput(options.out_dir / "scans.csv");
   scans << "t_s,scan,lidar_factor,fitness_m2,iterations,converged,inliers,hessian_condition,source_"
            "points,keyframe,note\n";
-  io::LasWriter map(options.out_dir / "map.las");
-  PointCloud map_for_ply;
+  // Keyframe scans go to disk in the body frame as they are made (memory stays flat); the map is
+  // exported from them at the end, with the final poses.
+  mapping::KeyframeStore keyframe_store = mapping::KeyframeStore::create(options.out_dir / "keyframes");
 
-  Trajectory trajectory, trajectory_imu, keyframes;
-  // Keyframe clouds wait here (world frame) until the world frame is levelled, then stream out.
-  std::vector<PointCloud> pending_map;
-  auto emitMap = [&](const PointCloud& cloud_in_world, std::size_t keyframe) {
-    map.append(cloud_in_world, static_cast<std::uint16_t>(keyframe % 65536));
-    if (options.write_ply) map_for_ply.append(cloud_in_world);
-  };
+  Trajectory trajectory, trajectory_imu;
   RunSummary summary;
   std::vector<double> totals_ms;
   Progress progress("taiga run", 0, "scans", stderr,
@@ -157,9 +167,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       const lie::SE3& T_new_old = *outcome.world_correction;
       trajectory = transformed(trajectory, T_new_old);
       trajectory_imu = transformed(trajectory_imu, T_new_old);
-      keyframes = transformed(keyframes, T_new_old);
-      for (PointCloud& cloud : pending_map)
-        for (Eigen::Vector3d& p : cloud.positions) p = T_new_old * p;
+      keyframe_store.setPoses(transformedPoses(keyframe_store.poses(), T_new_old));
     }
     appendIfLater(trajectory, outcome.t_s, outcome.T_world_body);
     for (const StampedPose& p : outcome.imu_rate_poses)
@@ -177,14 +185,9 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                          outcome.scan_index, lidarFactorName(outcome.lidar), r.fitness_m2,
                          r.iterations, r.converged ? 1 : 0, r.num_inliers, r.hessian_condition,
                          outcome.source_points, outcome.keyframe ? 1 : 0, outcome.lidar_note);
-    if (outcome.keyframe_cloud_in_body) {
-      appendIfLater(keyframes, outcome.t_s, outcome.T_world_body);
-      PointCloud cloud =
-          options.map_voxel_m > 0.0
-              ? preprocess::voxelFilter(*outcome.keyframe_cloud_in_body, options.map_voxel_m)
-              : *outcome.keyframe_cloud_in_body;
-      for (Eigen::Vector3d& p : cloud.positions) p = outcome.T_world_body * p;
-      pending_map.push_back(std::move(cloud));
+    if (outcome.keyframe_cloud_in_body &&
+        (keyframe_store.empty() || outcome.t_s > keyframe_store.info(keyframe_store.size() - 1).t_s)) {
+      keyframe_store.add(outcome.t_s, outcome.T_world_body, *outcome.keyframe_cloud_in_body);
       ++summary.keyframes;
     }
   };
@@ -202,11 +205,6 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
     progress.update(summary.scans);
     if (std::optional<ScanOutcome> first = odometry.takeFirstOutcome()) consume(*first);
     if (outcome) consume(*outcome);
-    if (odometry.levelled()) {
-      for (std::size_t k = 0; k < pending_map.size(); ++k)
-        emitMap(pending_map[k], summary.keyframes - pending_map.size() + k);
-      pending_map.clear();
-    }
     return true;
   };
   std::deque<io::RecordingEvent> read_ahead;
@@ -236,11 +234,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   } else {
     while (std::optional<io::RecordingEvent> event = recording.next()) handle(*event);
   }
-  for (std::size_t k = 0; k < pending_map.size(); ++k)
-    emitMap(pending_map[k], summary.keyframes - pending_map.size() + k);
   progress.finish();
-  map.close();
-  summary.map_points = map.pointCount();
   summary.wall_time_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
   if (trajectory.empty()) {
@@ -252,8 +246,16 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   }
   io::writeTum(options.out_dir / "trajectory.tum", trajectory);
   io::writeTum(options.out_dir / "trajectory_imu.tum", trajectory_imu);
-  io::writeTum(options.out_dir / "keyframes.tum", keyframes);
-  if (options.write_ply) io::writePly(options.out_dir / "map.ply", map_for_ply);
+  const std::vector<lie::SE3> keyframe_poses = finalKeyframePoses(keyframe_store);
+  keyframe_store.setPoses(keyframe_poses);
+  keyframe_store.writePoses();
+  io::writeTum(options.out_dir / "keyframes.tum", keyframe_store.trajectory());
+  const auto export_start = Clock::now();
+  const mapping::MapExportSummary map =
+      mapping::exportMap(keyframe_store, keyframe_poses, options.out_dir / "map.las",
+                         {.voxel_m = options.map_voxel_m, .write_ply = options.write_ply});
+  summary.map_points = map.points_written;
+  summary.map_export_s = std::chrono::duration<double>(Clock::now() - export_start).count();
 
   summary.duration_s = trajectory.endTime() - trajectory.startTime();
   summary.path_length_m = trajectory.pathLength();

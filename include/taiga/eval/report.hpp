@@ -6,6 +6,7 @@
 #include <string>
 
 #include "taiga/eval/evaluate.hpp"
+#include "taiga/eval/map_sharpness.hpp"
 #include "taiga/eval/timing.hpp"
 
 namespace taiga::eval {
@@ -18,6 +19,9 @@ struct EvalReport {
   std::optional<TimingTable> timing_table;
   std::optional<TimingStatistics> timing;
   bool show_distance = false;  ///< include the distance distribution in text and Markdown
+  /// `--map MAP --scene RECORDING`: the map's distance to the true surfaces (map_sharpness.hpp).
+  std::optional<MapSharpness> map_sharpness;
+  std::string map_file, scene_dir;
 };
 
 /// Statistics with 6 decimals, as evo prints them.

@@ -3,9 +3,14 @@
 //   trajectory.tum       one pose per scan (T_world_body at the scan's end)
 //   trajectory_imu.tum   IMU-rate poses (propagated between scans, as published live)
 //   keyframes.tum        the keyframe poses
-//   map.las              every keyframe's full deskewed scan in the world frame (GPS time =
-//                        point time, point source ID = keyframe number), streamed as keyframes
-//                        are made, so memory stays flat; map.ply on request
+//   keyframes/           every keyframe's full deskewed scan in the body frame (NNNNNN.tkf,
+//                        mapping/keyframe_file.hpp), written as keyframes are made so memory
+//                        stays flat, and their final poses (poses.tum): `taiga export-map`
+//                        re-exports the map from it
+//   map.las              every keyframe's scan in the world frame with its final pose (GPS
+//                        time = point time, point source ID = keyframe number), exported from
+//                        keyframes/ at the end of the run (mapping/map_export.hpp); map.ply on
+//                        request
 //   timing.csv           per scan: t_s and the stage durations in ms (docs/formats.md)
 //   scans.csv            per scan: registration diagnostics (fitness, iterations, lidar factor)
 //   summary.json         counts, per-scan time statistics, real-time factor, peak memory
@@ -20,8 +25,10 @@ namespace taiga::pipeline {
 
 struct RunOptions {
   std::filesystem::path out_dir;
-  bool write_ply = false;     ///< also map.ply (holds the map in memory until the end)
-  double map_voxel_m = 0.0;   ///< > 0: the map is decimated to one point per voxel per keyframe
+  bool write_ply = false;     ///< also map.ply (holds the map in memory while it is written)
+  /// > 0: the map is decimated to one point per voxel across all keyframes (the point nearest
+  /// each voxel's centre, mapping/map_export.hpp)
+  double map_voxel_m = 0.0;
   bool realtime = false;      ///< replay at sensor rate, dropping scans when behind
   std::size_t realtime_queue_scans = 2;  ///< scans that may wait before the oldest is dropped
   bool show_progress = true;  ///< a progress line on a terminal
@@ -47,7 +54,8 @@ struct RunSummary {
   double duration_s = 0.0;  ///< recording time covered by the states
   double path_length_m = 0.0;
   double mean_ms = 0.0, median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;
-  double wall_time_s = 0.0;
+  double wall_time_s = 0.0;   ///< reading and odometry, keyframe files included
+  double map_export_s = 0.0;  ///< map.las (and map.ply) from keyframes/ at the end
   double realtime_factor = 0.0;  ///< recording duration / wall time (> 1: faster than the sensor)
   double peak_memory_mb = 0.0;
   std::string initialization;
