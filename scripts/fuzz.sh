@@ -25,6 +25,14 @@ seed() {  # seed corpus of a target: small real files it should parse
       printf '\000FIELDS x y z t\nSIZE 4 4 4 4\nTYPE F F F U\nWIDTH 2\nPOINTS 2\nDATA ascii\n1 2 3 0\n4 5 6 100\n' > "$corpus/ascii_pcd"
       printf '\001ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n' > "$corpus/ascii_ply"
       { printf '\001'; head -c 2000 ../shared/data/registration/source.ply; } > "$corpus/binary_ply" 2>/dev/null || true ;;
+    fuzz_keyframe_files)
+      # A keyframe file of two points with every channel, and a LAS file of one point.
+      printf '\000TAIGAKF1\001\000\000\000\017\000\000\000\000\000\000\000\000\000\000\000\000\000\000\000\000\000\360\077\002\000\000\000\000\000\000\000' > "$corpus/keyframe"
+      head -c 80 /dev/zero >> "$corpus/keyframe"
+      /usr/bin/python3 -c 'import struct,sys
+h=bytearray(375); h[0:4]=b"LASF"; h[24]=1; h[25]=4; struct.pack_into("<HIIBHI",h,94,375,375,0,6,30,0)
+struct.pack_into("<3d3d",h,131,.001,.001,.001,0,0,0); struct.pack_into("<Q",h,247,1)
+sys.stdout.buffer.write(b"\x01"+bytes(h)+struct.pack("<3iH4BhHd",1000,2000,3000,7,17,0,1,5,0,3,1.7e9))' > "$corpus/las" ;;
     fuzz_ouster_packets)
       for json in ../shared/data/ouster/*.json; do
         [ -f "$json" ] && { printf '\000'; cat "$json"; } > "$corpus/$(basename "$json")"
