@@ -8,8 +8,8 @@
 // frame, the measured point nearest to the voxel's centre, with its own time, intensity, ring and
 // keyframe (as PDAL's filters.voxelcenternearestneighbor). Unlike a per-keyframe filter, a tree
 // seen from 50 keyframes is not kept 50 times. Ties go to the earlier keyframe, so the result does
-// not depend on anything but the store and the poses. Memory: about 100 B per output point (one
-// record per occupied voxel); the full-resolution scans are streamed (one keyframe in RAM at a
+// not depend on anything but the store and the poses. Memory: about 170 B per output point (a
+// hash-map entry and a record per occupied voxel); the full-resolution scans are streamed (one keyframe in RAM at a
 // time). Without decimation nothing but one keyframe is held, except for map.ply, which is
 // written at the end from the whole map in RAM (as io::writePly needs).
 
