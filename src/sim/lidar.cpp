@@ -216,15 +216,21 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   };
   // Half-angle tangent of the ring: a ring ray is tan_ring * t off the centre ray at range t.
   const double tan_ring = std::tan(ring_rad);
-  // Whether pixel (col, row), whose centre ray leaves origin_world along d_world, needs its ring.
-  // A range jump to an azimuth neighbour flags a possible edge; when the nearer side of the jump
-  // is a curve (stem, branch, twig: most edges in a forest), the cone's geometry settles it
-  // exactly and cheaply (ring_on_curve.hpp): the ring is cast only if it can cross the curve's
-  // silhouette. The neighbours are a column (0.35 deg) apart and the ring only 0.13 deg off the
-  // centre, so this skips about half of the flagged pixels (46 % -> 22 % of all pixels in the
-  // mixed stand), whose ring would have returned the centre's surface anyway.
-  auto needsRing = [&](int col, int row, const Eigen::Vector3d& origin_world,
-                       const Eigen::Vector3d& d_world) {
+  // The ring of pixel (col, row): a range jump to an azimuth neighbour flags a possible edge.
+  // When the nearer side of every jump is a curve (stem, branch, twig: most edges in a forest),
+  // the cones settle each ring ray exactly and cheaply (ring_on_curve.hpp): a ray that stays on
+  // the cone its own centre ray hit, or misses the nearer curve a neighbour's centre ray hit,
+  // sees what the centre ray saw and is not cast. The neighbours are a column (0.35 deg) apart
+  // and the ring only 0.13 deg off the centre, so most flagged rays are settled.
+  struct RingPlan {
+    bool edge = false;      ///< some azimuth neighbour's range jumps and its near side is solid
+    bool cast_all = false;  ///< a near side is not a curve (ground, rock): no shortcut
+    int n_curves = 0;
+    std::array<std::int32_t, 2> curve{};  ///< near-side curve segments
+    std::array<bool, 2> own{};            ///< the pixel's own centre ray hit it
+  };
+  auto planRing = [&](int col, int row) {
+    RingPlan plan;
     const double r = rangeAt(col, row);
     for (const int nb : {col - 1, col + 1}) {
       const double q = rangeAt(nb, row);
@@ -233,42 +239,43 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
       if (!(near_is_self ? solidAt(col, row) : solidAt(nb, row))) continue;
       if (!(q == kNoHit || r == kNoHit || std::abs(q - r) > 0.15 + 0.01 * std::min(r, q)))
         continue;
+      plan.edge = true;
       const std::int32_t near_segment = near_is_self ? segmentAt(col, row) : segmentAt(nb, row);
-      if (near_segment < 0) return true;  // a triangle (ground, rock): cast
-      const bool settled = near_is_self ? detail::ringStaysOnCurve(scene, near_segment, origin_world,
-                                                           d_world, r, tan_ring)
-                                        : detail::ringMissesCurve(scene, near_segment, origin_world,
-                                                          d_world, tan_ring);
-      if (!settled) return true;
+      if (near_segment < 0) {
+        plan.cast_all = true;
+        break;
+      }
+      plan.curve[plan.n_curves] = near_segment;
+      plan.own[plan.n_curves] = near_is_self;
+      ++plan.n_curves;
     }
-    return false;
+    return plan;
   };
   tbb::parallel_for(tbb::blocked_range<int>(0, cols, 16), [&](const tbb::blocked_range<int>&
                                                                   range) {
     std::array<SubHit, kMaxSubRays> hits{};
     std::vector<int> ring_rows;
+    /// Per ring row, k_rays - 1 slots: the index of the ray in ring_dirs, or -1 for a ray that
+    /// sees what the centre ray saw.
+    std::vector<int> ring_slots;
     std::vector<Eigen::Vector3d> ring_dirs;
     std::vector<double> ring_t_min;
     std::vector<std::optional<RayHit>> ring_hits;
+    std::array<Eigen::Vector3d, kMaxSubRays> pixel_dirs;
     for (int col = range.begin(); col != range.end(); ++col) {
       const Column& c = columns[col];
       // The ring rays of every pixel of the column that needs them, cast together in packets
-      // of 16 (Embree rtcIntersect16; about twice as fast as one rtcIntersect1 per ray).
+      // of 16 (Embree rtcIntersect16).
       ring_rows.clear();
+      ring_slots.clear();
       ring_dirs.clear();
       ring_t_min.clear();
       if (k_rays > 1) {
         for (int row = 0; row < rows; ++row) {
+          const RingPlan plan = planRing(col, row);
+          if (!plan.edge) continue;
           const std::uint64_t pixel_id = static_cast<std::uint64_t>(col) * rows + row;
           const Eigen::Vector3d d_world = c.R_world_lidar * direction(col, row);
-          if (!needsRing(col, row, c.origin_world, d_world)) continue;
-          ring_rows.push_back(row);
-          // The ring looks for the surfaces the centre rays around it found: it starts just in
-          // front of the nearest of them (a thin object in front of all three centre rays is
-          // missed, as it is by a pixel that is not at an edge). About 9 % faster (sim_bench).
-          double nearest_m = rangeAt(col, row);
-          for (const int nb : {col - 1, col + 1}) nearest_m = std::min(nearest_m, rangeAt(nb, row));
-          const double ring_t_min_m = std::max(0.0, nearest_m - kRingLead_m);
           const Eigen::Vector3d e1 =
               d_world
                   .cross(std::abs(d_world.z()) < 0.9 ? Eigen::Vector3d::UnitZ()
@@ -276,10 +283,42 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
                   .normalized();
           const Eigen::Vector3d e2 = d_world.cross(e1);
           const double spin = 2.0 * kPi * hashUniform(seed_, index, pixel_id, 101);
+          const std::int32_t own_segment = segment[pixel_id];
+          std::array<bool, kMaxSubRays> cast{};
+          bool any = false;
           for (int k = 1; k < k_rays; ++k) {
             const double a = spin + 2.0 * kPi * (k - 1) / (k_rays - 1);
-            ring_dirs.push_back(
-                (d_world + tan_ring * (std::cos(a) * e1 + std::sin(a) * e2)).normalized());
+            pixel_dirs[k] =
+                (d_world + tan_ring * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
+            cast[k] = plan.cast_all;
+            for (int i = 0; i < plan.n_curves && !cast[k]; ++i) {
+              cast[k] = plan.own[i] ? !detail::rayStaysOnCurve(scene, plan.curve[i],
+                                                               c.origin_world, pixel_dirs[k])
+                                    : !detail::rayMissesCurve(scene, plan.curve[i],
+                                                              c.origin_world, pixel_dirs[k]);
+            }
+            // A ray that misses the nearer curve sees what its centre saw only if it stays on
+            // that surface too: the centre's own curve may end between the two centre rays,
+            // behind the nearer one (a stem's edge behind a twig).
+            if (!cast[k] && own_segment >= 0)
+              cast[k] = !detail::rayStaysOnCurve(scene, own_segment, c.origin_world, pixel_dirs[k]);
+            any = any || cast[k];
+          }
+          if (!any) continue;  // the whole footprint sees what the centre ray saw
+          ring_rows.push_back(row);
+          // The ring looks for the surfaces the centre rays around it found: it starts just in
+          // front of the nearest of them (a thin object in front of all three centre rays is
+          // missed, as it is by a pixel that is not at an edge). About 9 % faster (sim_bench).
+          double nearest_m = rangeAt(col, row);
+          for (const int nb : {col - 1, col + 1}) nearest_m = std::min(nearest_m, rangeAt(nb, row));
+          const double ring_t_min_m = std::max(0.0, nearest_m - kRingLead_m);
+          for (int k = 1; k < k_rays; ++k) {
+            if (!cast[k]) {
+              ring_slots.push_back(-1);
+              continue;
+            }
+            ring_slots.push_back(static_cast<int>(ring_dirs.size()));
+            ring_dirs.push_back(pixel_dirs[k]);
             ring_t_min.push_back(ring_t_min_m);
           }
         }
@@ -298,10 +337,16 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
           if (center.range_m != kNoHit)
             hits[n_hits++] = {center.range_m, center_weight, center.reflectivity_eff};
           for (int k = 1; k < k_rays; ++k) {
-            const std::size_t ray = next_ring * static_cast<std::size_t>(k_rays - 1) + (k - 1);
-            const auto& hit = ring_hits[ray];
+            const int ray = ring_slots[next_ring * static_cast<std::size_t>(k_rays - 1) + (k - 1)];
+            if (ray < 0) {  // settled: sees the centre's surface
+              if (center.range_m != kNoHit)
+                hits[n_hits++] = {center.range_m, ring_weight, center.reflectivity_eff};
+              continue;
+            }
+            const auto& hit = ring_hits[static_cast<std::size_t>(ray)];
             if (!hit) continue;
-            const double cos_inc = std::max(0.05, std::abs(hit->normal_world.dot(ring_dirs[ray])));
+            const double cos_inc = std::max(
+                0.05, std::abs(hit->normal_world.dot(ring_dirs[static_cast<std::size_t>(ray)])));
             hits[n_hits++] = {hit->range_m, ring_weight, reflectivity(hit->material) * cos_inc};
           }
           ++next_ring;

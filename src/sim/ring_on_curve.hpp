@@ -1,17 +1,17 @@
 #pragma once
-// Where the lidar's beam-divergence ring can change a return, decided from the geometry of the
-// curve (a cone segment of a stem, branch or twig) on the near side of an edge, without casting
-// the ring (lidar.cpp, pass 2).
+// Whether a ring ray of the lidar's beam-divergence model can return something other than its
+// centre ray, decided from the geometry of the curve (a cone segment of a stem, branch or twig)
+// on the near side of an edge, without casting it (lidar.cpp, pass 2): a ring ray that certainly
+// stays on the cone its centre ray hit, or certainly misses the nearer curve a neighbouring
+// pixel's centre ray hit, sees what the centre ray saw.
 //
-// The ring rays leave the centre ray's origin at an angle whose tangent is tan_ring, so at range
-// t they are at most rho(t) = tan_ring * t off the centre ray. Between a line and a cone segment
-// (axis a + s (b - a), s in [0, 1]) the closest approach is the classic line-segment one
-// (Ericson, Real-Time Collision Detection, 5.1.9; the squared distance is convex in s, so
-// clamping the unconstrained s gives the nearest point of the segment). Both tests are
-// conservative: 20 % and 2 mm of slack on rho, the thinner end's radius where the ring must stay
-// on the cone and the thicker one's where it must miss; free ends (the top of a stem, twig and
-// branch tips) need an axial margin; rays within ~12 deg of the axis (looking along a branch)
-// are never settled.
+// Between a line and a cone segment (axis a + s (b - a), s in [0, 1]) the closest approach is
+// the classic line-segment one (Ericson, Real-Time Collision Detection, 5.1.9; the squared
+// distance is convex in s, so clamping the unconstrained s gives the nearest point of the
+// segment). Both tests are conservative: 2 mm + 0.01 % of the range of slack, the thinner end's
+// radius where the ray must stay on the cone and the thicker one's where it must miss; free ends
+// (the top of a stem, twig and branch tips) need an axial margin; rays within ~12 deg of the axis
+// (looking along a branch) are never settled.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -48,38 +48,39 @@ inline LineSegmentApproach approach(const CurveSegment& seg, const Eigen::Vector
   return out;
 }
 
-/// Slack on the ring's offset at range t.
-inline double ringOffset(double tan_ring, double t_m) { return 1.2 * tan_ring * t_m + 0.002; }
+/// Slack for the float geometry Embree intersects (a few 1e-5 relative) and the taper, m.
+inline double raySlack(double t_m) { return 0.002 + 1e-4 * std::abs(t_m); }
 
-/// True if every ring ray of a centre ray (origin, d) that hit curve segment `index` at range
-/// `range_m` hits the same cone too (so the ring would return the centre's surface).
-inline bool ringStaysOnCurve(const Scene& scene, std::int32_t index, const Eigen::Vector3d& origin,
-                             const Eigen::Vector3d& d, double range_m, double tan_ring) {
+/// True if the ray (origin, unit d) certainly hits the cone of curve segment `index` (or a
+/// segment joined to it): it passes the axis closer than the thinner end's radius, between the
+/// ends, and a free end is not within reach of where it enters.
+inline bool rayStaysOnCurve(const Scene& scene, std::int32_t index, const Eigen::Vector3d& origin,
+                            const Eigen::Vector3d& d) {
   const CurveSegment seg = scene.curveSegment(index);
   const LineSegmentApproach ap = approach(seg, origin, d, false);
   if (ap.sin_angle < 0.2 || ap.s < 0.0 || ap.s > 1.0) return false;
   const double r_min = std::min(seg.radius_a_m, seg.radius_b_m);
   const double r_max = std::max(seg.radius_a_m, seg.radius_b_m);
-  const double rho = ringOffset(tan_ring, std::max(range_m, ap.t_m) + r_max);
-  if (ap.distance_m + rho > r_min) return false;
-  // A free end must be far enough along the axis that no ring ray slips past it.
-  const double margin_m = (rho + r_max) / ap.sin_angle;
+  const double slack = raySlack(ap.t_m);
+  if (ap.distance_m + slack > r_min) return false;
+  // The ray crosses the mantle within r / tan(angle) of its closest approach along the axis.
+  const double margin_m = r_max / ap.sin_angle + slack;
   if (!seg.continues_before && ap.s * ap.length_m < margin_m) return false;
   if (!seg.continues_after && (1.0 - ap.s) * ap.length_m < margin_m) return false;
   return true;
 }
 
-/// True if no ring ray of the centre ray (origin, d) can touch curve segment `index` or the
-/// segments joined to it (the nearer surface that a neighbouring pixel's centre ray hit).
-inline bool ringMissesCurve(const Scene& scene, std::int32_t index, const Eigen::Vector3d& origin,
-                            const Eigen::Vector3d& d, double tan_ring) {
+/// True if the ray (origin, unit d) certainly misses curve segment `index` and the segments
+/// joined to it: it passes each further from its axis than the thicker end's radius (the
+/// segment capped by spheres of that radius holds the cone).
+inline bool rayMissesCurve(const Scene& scene, std::int32_t index, const Eigen::Vector3d& origin,
+                           const Eigen::Vector3d& d) {
   const CurveSegment seg = scene.curveSegment(index);
   auto misses = [&](const CurveSegment& s) {
     const LineSegmentApproach ap = approach(s, origin, d, true);
     if (ap.sin_angle < 0.2) return false;
     const double r_max = std::max(s.radius_a_m, s.radius_b_m);
-    // The segment, capped by spheres of its larger radius, holds the cone.
-    return ap.distance_m - r_max > ringOffset(tan_ring, std::max(ap.t_m, 0.0) + r_max);
+    return ap.distance_m - r_max > raySlack(ap.t_m);
   };
   if (!misses(seg)) return false;
   if (seg.continues_before && !misses(scene.curveSegment(index - 1))) return false;

@@ -105,6 +105,40 @@ TEST(Lidar, BeamDivergenceMixesRangesAtEdges) {
   EXPECT_GT(mixed, 20) << "mixed returns between a stem's edge and its background";
 }
 
+TEST(Lidar, StemEdgesGiveMixedReturnsBesideTheStem) {
+  // Stems look wider than they are: with divergence, returns float in the air just beside a
+  // stem (2-30 cm outside its true surface, at 0.3-6 m) between its edge and its background;
+  // without divergence there are none.
+  Scenario wide = smallScenario(false);
+  wide.lidar.sub_rays = 4;
+  wide.lidar.columns = 1024;
+  Scenario thin = wide;
+  thin.lidar.sub_rays = 1;
+  const Simulation a(wide, 1.0, 2), b(thin, 1.0, 2);
+  auto besideStems = [](const Simulation& sim) {
+    const io::Scan scan = sim.lidar().simulateScan(sim.scene(), sim.motion(), 1, 0.1);
+    const lie::SE3 T_body_lidar = sim.lidar().T_body_lidar();
+    int floating = 0;
+    for (std::size_t i = 0; i < scan.cloud_in_lidar.size(); ++i) {
+      const lie::SE3 T_world_body = sim.motion().at(scan.cloud_in_lidar.times_s[i]).T_world_body;
+      const Eigen::Vector3d p = T_world_body * (T_body_lidar * scan.cloud_in_lidar.positions[i]);
+      for (const Tree& tree : sim.scene().trees()) {
+        const double s = p.z() - tree.base_world.z();
+        if (s < 0.3 || s > 6.0) continue;
+        const double outside_m = (p - tree.axisAt(s)).head<2>().norm() - tree.radiusAt(s);
+        if (outside_m > 0.02 && outside_m < 0.3 && sim.scene().distanceToSurface(p, 2.0) > 0.05)
+          ++floating;
+      }
+    }
+    return floating;
+  };
+  const int mixed = besideStems(a), exact = besideStems(b);
+  RecordProperty("floating_beside_stems_with_divergence", mixed);
+  RecordProperty("floating_beside_stems_without", exact);
+  EXPECT_EQ(exact, 0);
+  EXPECT_GE(mixed, 10) << "stem edges mixed with their background";
+}
+
 TEST(Lidar, ScanTimesColumnsAndReturns) {
   const Simulation sim(smallScenario(true), 2.0, 2);
   const io::Scan scan = sim.lidar().simulateScan(sim.scene(), sim.motion(), 5, 0.5, 100.0);
