@@ -9,6 +9,8 @@
 #include "../imu/imu_test_motion.hpp"
 #include "taiga/backend/imu_factor.hpp"
 #include "taiga/backend/pose_factor.hpp"
+#include "taiga/backend/position_factor.hpp"
+#include "taiga/backend/relative_pose_factor.hpp"
 #include "taiga/backend/state_prior.hpp"
 
 namespace taiga::backend {
@@ -98,6 +100,31 @@ TEST(FactorJacobians, PoseFactorMatchesNumericalDifferentiation) {
   covariance(0, 4) = covariance(4, 0) = 0.002;
   for (int trial = 0; trial < 5; ++trial) {
     const PoseFactor factor(randomState(rng).T_world_body(), covariance);
+    EXPECT_LT(worstJacobianError(factor, {vec(randomState(rng).pose)}), 1e-6);
+  }
+}
+
+TEST(FactorJacobians, RelativePoseFactorMatchesNumericalDifferentiation) {
+  std::mt19937_64 rng(8);
+  lie::Matrix6 covariance = lie::Matrix6::Identity() * 0.01;
+  covariance(1, 3) = covariance(3, 1) = 0.003;
+  for (int trial = 0; trial < 5; ++trial) {
+    const lie::SE3 T_i_j_measured = randomState(rng).T_world_body();
+    const RelativePoseFactor factor(T_i_j_measured, covariance);
+    const StateBlocks i = randomState(rng), j = randomState(rng);
+    EXPECT_LT(worstJacobianError(factor, {vec(i.pose), vec(j.pose)}), 1e-6);
+    // Zero exactly at the measurement.
+    const lie::SE3 T_world_j = i.T_world_body() * T_i_j_measured;
+    EXPECT_LT(factor.error(i.T_world_body(), T_world_j).norm(), 1e-12);
+  }
+}
+
+TEST(FactorJacobians, PositionFactorMatchesNumericalDifferentiation) {
+  std::mt19937_64 rng(9);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity() * 0.5;
+  covariance(0, 2) = covariance(2, 0) = 0.2;
+  for (int trial = 0; trial < 5; ++trial) {
+    const PositionFactor factor(randomState(rng).T_world_body().translation(), covariance);
     EXPECT_LT(worstJacobianError(factor, {vec(randomState(rng).pose)}), 1e-6);
   }
 }

@@ -3,6 +3,7 @@
 // modules that own them land.
 
 #include "taiga/core/config.hpp"
+#include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/core/recording_config.hpp"
 #include "taiga/core/rig_config.hpp"
@@ -13,12 +14,14 @@ struct SystemConfig final : ConfigSection {
   RigConfig rig;
   RecordingConfig recording;
   OdometryConfig odometry;
+  MappingConfig mapping;
 
   void visit(ConfigVisitor& v) override {
     v.section("rig", rig, "sensor rig: extrinsics, clock offset and units");
     v.section("recording", recording, "which streams to read and how to interpret them");
     v.section("odometry", odometry,
               "lidar-inertial odometry: preprocessing, registration, keyframes, IMU noise");
+    v.section("mapping", mapping, "keyframe graph and loop closures");
   }
 };
 

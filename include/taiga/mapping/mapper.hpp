@@ -1,0 +1,92 @@
+#pragma once
+// The mapping back end of thesis 3.1.2: keyframes from the odometry enter the pose graph, loop
+// closures are searched at most once per loop_min_interval_s of recording time and kept when
+// they verify (loop_closure.hpp) and agree with the graph (the chi^2 of the cost they add).
+// MappingThread runs it beside the odometry, so the odometry never waits for it.
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "taiga/core/mapping_config.hpp"
+#include "taiga/core/odometry_config.hpp"
+#include "taiga/mapping/keyframe_store.hpp"
+#include "taiga/mapping/loop_closure.hpp"
+#include "taiga/mapping/pose_graph.hpp"
+
+namespace taiga::mapping {
+
+/// One loop closure attempt and what became of it (loops.csv).
+struct LoopRecord {
+  double t_s = 0.0;
+  LoopAttempt attempt;
+  double chi2 = 0.0;  ///< cost the loop added, as chi^2 (0 when it did not get that far)
+};
+
+class Mapper {
+ public:
+  /// Reads the keyframes' registration clouds from `store` (which must outlive the mapper).
+  Mapper(const MappingConfig& config, const OdometryConfig& odometry, const KeyframeStore& store);
+
+  /// Keyframe `id` of the store (ids in order, from 0) at its odometry pose.
+  void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
+  /// The odometry re-expressed its world frame (gravity levelling): T_new_old.
+  void changeWorldFrame(const lie::SE3& T_new_old) { graph_.changeWorldFrame(T_new_old); }
+
+  const PoseGraph& graph() const { return graph_; }
+  const std::vector<LoopRecord>& loopAttempts() const { return attempts_; }
+  std::size_t loopClosures() const { return graph_.loops().size(); }
+
+ private:
+  void tryLoopClosure(std::size_t current, double t_s);
+
+  MappingConfig config_;
+  OdometryConfig odometry_;
+  const KeyframeStore& store_;
+  PoseGraph graph_;
+  std::optional<double> last_attempt_s_;
+  std::vector<LoopRecord> attempts_;
+};
+
+/// A Mapper on its own thread. Messages are handled in order, so the result does not depend on
+/// timing: the same recording gives the same map.
+class MappingThread {
+ public:
+  MappingThread(const MappingConfig& config, const OdometryConfig& odometry,
+                const KeyframeStore& store);
+  ~MappingThread();
+  MappingThread(const MappingThread&) = delete;
+  MappingThread& operator=(const MappingThread&) = delete;
+
+  void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
+  void changeWorldFrame(const lie::SE3& T_new_old);
+  /// Waits until every message is handled, stops the thread and hands out the mapper. Rethrows
+  /// what the thread threw.
+  Mapper& finish();
+
+ private:
+  struct KeyframeMessage {
+    std::size_t id;
+    double t_s;
+    lie::SE3 T_odom_body;
+  };
+  using Message = std::variant<KeyframeMessage, lie::SE3>;
+  void push(Message message);
+  void work();
+
+  Mapper mapper_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<Message> queue_;
+  bool stopping_ = false;
+  std::exception_ptr error_;
+  std::thread worker_;
+};
+
+}  // namespace taiga::mapping

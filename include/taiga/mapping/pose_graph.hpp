@@ -1,0 +1,90 @@
+#pragma once
+// The mapping graph of thesis 3.1.2: one node per keyframe (T_world_body), consecutive keyframes
+// joined by the odometry's relative pose, loop closures as further relative poses, and absolute
+// position factors (GNSS, issue 9) through addPosition(). Solved with Ceres when a loop or an
+// absolute factor arrives; in between, a new keyframe is placed by chaining the odometry onto
+// the corrected pose of the previous one.
+//
+// Gauge: without absolute factors the first keyframe is held fixed, so the corrected map stays
+// in the odometry's world frame at its start.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "taiga/core/mapping_config.hpp"
+#include "taiga/lie/se3.hpp"
+
+namespace taiga::mapping {
+
+/// A relative pose between two keyframes: T_from_to maps points of `to`'s body frame into
+/// `from`'s; covariance in the right-perturbation tangent [rho (m); theta (rad)] of T_from_to.
+struct RelativePose {
+  std::size_t from = 0;
+  std::size_t to = 0;
+  lie::SE3 T_from_to;
+  lie::Matrix6 covariance = lie::Matrix6::Identity();
+};
+
+class PoseGraph {
+ public:
+  explicit PoseGraph(const MappingConfig& config);
+
+  /// Appends a keyframe at its odometry pose and returns its index (0, 1, ...). From the
+  /// second on, an odometry factor joins it to the previous keyframe, with the sigmas of
+  /// MappingConfig grown with the distance between them.
+  std::size_t addKeyframe(const lie::SE3& T_odom_body);
+  /// A loop closure factor (from < to).
+  void addLoop(const RelativePose& loop);
+  /// Adds `loop` and re-optimizes when the loop agrees with the graph: when it raises the
+  /// optimal cost by at most max_chi2 / 2. A correct loop adds about its innovation's squared
+  /// Mahalanobis distance against the odometry's accumulated uncertainty; a false one bends the
+  /// graph and costs far more. Returns that chi^2; the graph is unchanged when it is above.
+  double addLoopIfConsistent(const RelativePose& loop, double max_chi2);
+  /// An absolute position of a keyframe in the world frame (m) with its covariance (m^2);
+  /// `huber_sigmas` > 0 makes the factor robust beyond that many sigmas.
+  void addPosition(std::size_t keyframe, const Eigen::Vector3d& p_world,
+                   const Eigen::Matrix3d& covariance, double huber_sigmas = 0.0);
+
+  /// Re-expresses every pose in a new world frame (T_new_old * pose); the factors are relative
+  /// and stay as they are. Only without absolute factors.
+  void changeWorldFrame(const lie::SE3& T_new_old);
+
+  /// Solves for every keyframe pose; returns the final cost.
+  double optimize();
+  /// The cost at the current poses after the last optimize() (0 before); keyframes added since
+  /// sit on their odometry factors and add nothing.
+  double cost() const { return cost_; }
+
+  std::size_t size() const { return odometry_poses_.size(); }
+  /// The corrected pose of a keyframe.
+  const lie::SE3& pose(std::size_t keyframe) const { return poses_[keyframe]; }
+  const std::vector<lie::SE3>& poses() const { return poses_; }
+  /// The pose the odometry gave the keyframe.
+  const lie::SE3& odometryPose(std::size_t keyframe) const { return odometry_poses_[keyframe]; }
+  /// Odometry path length from the first keyframe to `keyframe`, m.
+  double pathLength(std::size_t keyframe) const { return path_lengths_m_[keyframe]; }
+  const std::vector<RelativePose>& loops() const { return loops_; }
+
+  /// Squared Mahalanobis distance of a relative pose measurement from the current estimate.
+  double mahalanobis2(const RelativePose& measurement) const;
+
+ private:
+  struct Position {
+    std::size_t keyframe;
+    Eigen::Vector3d p_world;
+    Eigen::Matrix3d covariance;
+    double huber_sigmas;
+  };
+  RelativePose odometryBetween(std::size_t from, std::size_t to) const;
+
+  MappingConfig config_;
+  std::vector<lie::SE3> odometry_poses_;
+  std::vector<lie::SE3> poses_;
+  std::vector<double> path_lengths_m_;
+  std::vector<RelativePose> loops_;
+  std::vector<Position> positions_;
+  double cost_ = 0.0;
+};
+
+}  // namespace taiga::mapping

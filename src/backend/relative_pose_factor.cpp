@@ -1,0 +1,59 @@
+#include "taiga/backend/relative_pose_factor.hpp"
+
+#include <Eigen/Cholesky>
+
+namespace taiga::backend {
+namespace {
+
+// The pose block's tangent [dp (world); dtheta (body)] as an SE(3) right perturbation:
+// T Exp([R^T dp; dtheta]) to first order (see pose_factor.cpp).
+lie::Matrix6 blockTangentToSe3(const lie::SE3& T_world_body) {
+  lie::Matrix6 to_se3 = lie::Matrix6::Identity();
+  to_se3.topLeftCorner<3, 3>() = T_world_body.rotation().inverse().matrix();
+  return to_se3;
+}
+
+lie::SE3 poseOf(const double* block) {
+  StateBlocks state;
+  std::copy(block, block + kPoseSize, state.pose.begin());
+  return state.T_world_body();
+}
+
+}  // namespace
+
+RelativePoseFactor::RelativePoseFactor(const lie::SE3& T_i_j_measured,
+                                       const lie::Matrix6& covariance)
+    : T_j_i_measured_(T_i_j_measured.inverse()),
+      sqrt_information_(Eigen::LLT<lie::Matrix6>(covariance.inverse()).matrixL().transpose()) {}
+
+lie::Vector6 RelativePoseFactor::error(const lie::SE3& T_world_i, const lie::SE3& T_world_j) const {
+  return (T_j_i_measured_ * (T_world_i.inverse() * T_world_j)).Log();
+}
+
+bool RelativePoseFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const lie::SE3 T_world_i = poseOf(parameters[0]);
+  const lie::SE3 T_world_j = poseOf(parameters[1]);
+  const lie::SE3 T_i_j = T_world_i.inverse() * T_world_j;
+  const lie::Vector6 r = (T_j_i_measured_ * T_i_j).Log();
+  Eigen::Map<lie::Vector6>{residuals} = sqrt_information_ * r;
+  if (!jacobians) return true;
+  const lie::Matrix6 Jr_inv = lie::SE3::rightJacobianInverse(r);
+  // E = M T_i^-1 T_j. Right-perturbing T_j by xi gives E Exp(xi): dr/dxi_j = Jr^-1(r).
+  // Right-perturbing T_i gives M Exp(-xi) T_i^-1 T_j = E Exp(-Ad(T_j^-1 T_i) xi):
+  // dr/dxi_i = -Jr^-1(r) Ad(T_i_j^-1).
+  if (jacobians[0]) {
+    Eigen::Map<Eigen::Matrix<double, 6, kPoseSize, Eigen::RowMajor>> J(jacobians[0]);
+    J.setZero();
+    J.leftCols<6>() = -sqrt_information_ * Jr_inv * T_i_j.inverse().adjoint() *
+                      blockTangentToSe3(T_world_i);
+  }
+  if (jacobians[1]) {
+    Eigen::Map<Eigen::Matrix<double, 6, kPoseSize, Eigen::RowMajor>> J(jacobians[1]);
+    J.setZero();
+    J.leftCols<6>() = sqrt_information_ * Jr_inv * blockTangentToSe3(T_world_j);
+  }
+  return true;
+}
+
+}  // namespace taiga::backend

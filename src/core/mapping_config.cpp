@@ -1,0 +1,54 @@
+#include "taiga/core/mapping_config.hpp"
+
+namespace taiga {
+
+void MappingConfig::visit(ConfigVisitor& v) {
+  v.field("loop_closure", loop_closure,
+          "search for loop closures and correct the keyframe poses with them");
+  v.field("loop_exclude_recent_keyframes", loop_exclude_recent_keyframes,
+          "keyframes, the most recent ones are never loop candidates (thesis: 40)");
+  v.field("loop_search_radius_m", loop_search_radius_m,
+          "m, search radius around the current keyframe (thesis: 5 m)");
+  v.field("loop_radius_growth_m_per_m", loop_radius_growth_m_per_m,
+          "m per m of path travelled since the candidate, added to the radius for the drift");
+  v.field("loop_max_search_radius_m", loop_max_search_radius_m, "m, cap of the grown radius");
+  v.field("loop_min_interval_s", loop_min_interval_s,
+          "s, at most one loop closure attempt per this interval (thesis: 1.5 s)");
+  v.field("loop_submap_keyframes", loop_submap_keyframes,
+          "keyframes on each side of the candidate that form the map the scan is registered to");
+  v.field("loop_max_fitness_m2", loop_max_fitness_m2,
+          "m^2, loop registrations with a worse fitness are rejected");
+  v.field("loop_max_rotation_deg", loop_max_rotation_deg,
+          "deg, loops that would rotate the current keyframe further are rejected");
+  v.field("loop_max_chi2", loop_max_chi2,
+          "loops that raise the optimal cost of the graph by more (as chi^2: twice the cost "
+          "change) disagree with the odometry and are rejected as false");
+  v.field("odometry_sigma_m", odometry_sigma_m,
+          "m, sigma of the translation between consecutive keyframes, at zero distance");
+  v.field("odometry_sigma_m_per_m", odometry_sigma_m_per_m,
+          "m per m travelled between the keyframes, added to that sigma");
+  v.field("odometry_sigma_rad", odometry_sigma_rad,
+          "rad, sigma of the rotation between consecutive keyframes, at zero distance");
+  v.field("odometry_sigma_rad_per_m", odometry_sigma_rad_per_m,
+          "rad per m travelled between the keyframes, added to that sigma");
+}
+
+void MappingConfig::validate() const {
+  requireInRange("loop_exclude_recent_keyframes", loop_exclude_recent_keyframes, 1, 100000,
+                 "keyframes");
+  requirePositive("loop_search_radius_m", loop_search_radius_m, "m");
+  requireNonNegative("loop_radius_growth_m_per_m", loop_radius_growth_m_per_m, "m/m");
+  requireInRange("loop_max_search_radius_m", loop_max_search_radius_m, loop_search_radius_m,
+                 1000.0, "m");
+  requireNonNegative("loop_min_interval_s", loop_min_interval_s, "s");
+  requireInRange("loop_submap_keyframes", loop_submap_keyframes, 1, 100, "keyframes");
+  requirePositive("loop_max_fitness_m2", loop_max_fitness_m2, "m^2");
+  requireInRange("loop_max_rotation_deg", loop_max_rotation_deg, 0.1, 180.0, "deg");
+  requirePositive("loop_max_chi2", loop_max_chi2, "");
+  requirePositive("odometry_sigma_m", odometry_sigma_m, "m");
+  requireNonNegative("odometry_sigma_m_per_m", odometry_sigma_m_per_m, "m/m");
+  requirePositive("odometry_sigma_rad", odometry_sigma_rad, "rad");
+  requireNonNegative("odometry_sigma_rad_per_m", odometry_sigma_rad_per_m, "rad/m");
+}
+
+}  // namespace taiga

@@ -1,0 +1,98 @@
+#include "taiga/mapping/loop_closure.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "taiga/registration/registration.hpp"
+
+namespace taiga::mapping {
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+}  // namespace
+
+std::optional<LoopCandidate> findLoopCandidate(const PoseGraph& graph, std::size_t current,
+                                               const MappingConfig& config) {
+  const auto excluded = static_cast<std::size_t>(config.loop_exclude_recent_keyframes);
+  if (current < excluded) return std::nullopt;
+  const Eigen::Vector3d& p_current = graph.pose(current).translation();
+  std::optional<LoopCandidate> best;
+  for (std::size_t k = 0; k + excluded <= current; ++k) {
+    const double radius_m =
+        std::min(config.loop_search_radius_m + config.loop_radius_growth_m_per_m *
+                                                   (graph.pathLength(current) - graph.pathLength(k)),
+                 config.loop_max_search_radius_m);
+    const double distance_m = (graph.pose(k).translation() - p_current).norm();
+    if (distance_m <= radius_m && (!best || distance_m < best->distance_m))
+      best = LoopCandidate{k, distance_m, radius_m};
+  }
+  return best;
+}
+
+LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::size_t current,
+                       const LoopCandidate& candidate, const MappingConfig& config,
+                       const OdometryConfig& odometry) {
+  LoopAttempt attempt{.current = current, .candidate = candidate};
+  const std::shared_ptr<const PointCloud> source = store.registrationCloud(current);
+
+  // The candidate's submap: its neighbours (never the recent keyframes) in its body frame.
+  const std::size_t half = static_cast<std::size_t>(config.loop_submap_keyframes);
+  const std::size_t first = candidate.keyframe >= half ? candidate.keyframe - half : 0;
+  const std::size_t last =
+      std::min(candidate.keyframe + half,
+               current - static_cast<std::size_t>(config.loop_exclude_recent_keyframes));
+  const lie::SE3 T_candidate_world = graph.pose(candidate.keyframe).inverse();
+  std::vector<Eigen::Vector3d> submap_in_candidate;
+  for (std::size_t k = first; k <= last; ++k) {
+    const lie::SE3 T_candidate_k = T_candidate_world * graph.pose(k);
+    for (const Eigen::Vector3d& p_k : store.registrationCloud(k)->positions)
+      submap_in_candidate.push_back(T_candidate_k * p_k);
+  }
+
+  registration::RegistrationConfig registration_config;
+  registration_config.ndt.resolution_m = odometry.ndt_resolution_m;
+  // The guess may be off by the drift since the candidate: a coarse pass widens the basin.
+  registration_config.ndt.coarse_resolutions_m = {3.0 * odometry.ndt_resolution_m};
+  registration_config.ndt.search = registration::NeighbourSearch::kDirect7;
+  const lie::SE3 guess_T_candidate_current = T_candidate_world * graph.pose(current);
+  attempt.registration = registration::registerClouds(source->positions, submap_in_candidate,
+                                                      guess_T_candidate_current,
+                                                      registration_config);
+  const registration::RegistrationResult& r = attempt.registration;
+  const lie::Vector6 correction = (guess_T_candidate_current.inverse() * r.T_target_source).Log();
+  attempt.correction_m = correction.head<3>().norm();
+  attempt.correction_deg = correction.tail<3>().norm() / kDegToRad;
+
+  if (!r.converged) {
+    attempt.note = "registration did not converge: " + r.reason;
+  } else if (!(r.fitness_m2 <= config.loop_max_fitness_m2)) {
+    attempt.note = fmt::format("fitness {:.3f} m^2 above {:.3f}", r.fitness_m2,
+                               config.loop_max_fitness_m2);
+  } else if (attempt.correction_m > candidate.search_radius_m ||
+             attempt.correction_deg > config.loop_max_rotation_deg) {
+    attempt.note = fmt::format("correction {:.2f} m / {:.2f} deg beyond {:.2f} m / {:.1f} deg",
+                               attempt.correction_m, attempt.correction_deg,
+                               candidate.search_radius_m, config.loop_max_rotation_deg);
+  } else {
+    attempt.accepted = true;
+  }
+  // Thesis Eq. 36, as for the odometry's lidar factor (docs/odometry.md).
+  const double ratio = std::max(1.0, r.fitness_m2 / odometry.fitness_threshold_m2);
+  const double growth = std::pow(ratio, odometry.fitness_sigma_exponent);
+  const double sigma_m = odometry.lidar_sigma * growth;
+  const double sigma_rad = (odometry.lidar_heading_sigma_rad > 0.0 ? odometry.lidar_heading_sigma_rad
+                                                                   : odometry.lidar_sigma) *
+                           growth;
+  lie::Vector6 variances;
+  variances << lie::Vector3::Constant(sigma_m * sigma_m),
+      lie::Vector3::Constant(sigma_rad * sigma_rad);
+  attempt.loop = RelativePose{candidate.keyframe, current, r.T_target_source,
+                              variances.asDiagonal().toDenseMatrix()};
+  return attempt;
+}
+
+}  // namespace taiga::mapping

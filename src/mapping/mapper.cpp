@@ -1,0 +1,106 @@
+#include "taiga/mapping/mapper.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "taiga/core/log.hpp"
+
+namespace taiga::mapping {
+
+Mapper::Mapper(const MappingConfig& config, const OdometryConfig& odometry,
+               const KeyframeStore& store)
+    : config_(config), odometry_(odometry), store_(store), graph_(config) {}
+
+void Mapper::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body) {
+  const std::size_t index = graph_.addKeyframe(T_odom_body);
+  if (index != id) throw std::logic_error("Mapper: keyframes must arrive in id order");
+  if (!config_.loop_closure) return;
+  if (last_attempt_s_ && t_s - *last_attempt_s_ < config_.loop_min_interval_s) return;
+  tryLoopClosure(index, t_s);
+}
+
+void Mapper::tryLoopClosure(std::size_t current, double t_s) {
+  const std::optional<LoopCandidate> candidate = findLoopCandidate(graph_, current, config_);
+  if (!candidate) return;
+  last_attempt_s_ = t_s;
+  LoopRecord record{.t_s = t_s,
+                    .attempt = verifyLoop(graph_, store_, current, *candidate, config_, odometry_)};
+  if (record.attempt.accepted) {
+    record.chi2 = graph_.addLoopIfConsistent(record.attempt.loop, config_.loop_max_chi2);
+    if (record.chi2 <= config_.loop_max_chi2) {
+      logger().debug("loop closed: keyframe {} to {}, {:.2f} m / {:.2f} deg, chi2 {:.1f}", current,
+                     candidate->keyframe, record.attempt.correction_m,
+                     record.attempt.correction_deg, record.chi2);
+    } else {
+      record.attempt.accepted = false;
+      record.attempt.note = fmt::format("inconsistent with the graph: chi2 {:.1f} above {:.1f}",
+                                        record.chi2, config_.loop_max_chi2);
+    }
+  }
+  attempts_.push_back(std::move(record));
+}
+
+MappingThread::MappingThread(const MappingConfig& config, const OdometryConfig& odometry,
+                             const KeyframeStore& store)
+    : mapper_(config, odometry, store), worker_([this] { work(); }) {}
+
+MappingThread::~MappingThread() {
+  {
+    const std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void MappingThread::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body) {
+  push(KeyframeMessage{id, t_s, T_odom_body});
+}
+
+void MappingThread::changeWorldFrame(const lie::SE3& T_new_old) { push(T_new_old); }
+
+void MappingThread::push(Message message) {
+  {
+    const std::lock_guard lock(mutex_);
+    queue_.push_back(std::move(message));
+  }
+  wake_.notify_all();
+}
+
+void MappingThread::work() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+    if (queue_.empty()) return;  // stopping, everything handled
+    Message message = std::move(queue_.front());
+    queue_.pop_front();
+    if (error_) continue;  // drain; the first error is reported by finish()
+    lock.unlock();
+    try {
+      if (const auto* keyframe = std::get_if<KeyframeMessage>(&message)) {
+        mapper_.addKeyframe(keyframe->id, keyframe->t_s, keyframe->T_odom_body);
+      } else {
+        mapper_.changeWorldFrame(std::get<lie::SE3>(message));
+      }
+    } catch (...) {
+      lock.lock();
+      error_ = std::current_exception();
+      continue;
+    }
+    lock.lock();
+  }
+}
+
+Mapper& MappingThread::finish() {
+  {
+    const std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  if (error_) std::rethrow_exception(error_);
+  return mapper_;
+}
+
+}  // namespace taiga::mapping

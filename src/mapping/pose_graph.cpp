@@ -1,0 +1,126 @@
+#include "taiga/mapping/pose_graph.hpp"
+
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <array>
+#include <memory>
+
+#include "taiga/backend/position_factor.hpp"
+#include "taiga/backend/relative_pose_factor.hpp"
+#include "taiga/backend/state_blocks.hpp"
+
+namespace taiga::mapping {
+namespace {
+
+using PoseBlock = std::array<double, backend::kPoseSize>;
+
+PoseBlock toBlock(const lie::SE3& T_world_body) {
+  const Eigen::Quaterniond q = T_world_body.rotation().quaternion();
+  const Eigen::Vector3d& p = T_world_body.translation();
+  return {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
+}
+
+lie::SE3 fromBlock(const PoseBlock& block) {
+  backend::StateBlocks state;
+  state.pose = block;
+  return state.T_world_body();
+}
+
+}  // namespace
+
+PoseGraph::PoseGraph(const MappingConfig& config) : config_(config) {}
+
+std::size_t PoseGraph::addKeyframe(const lie::SE3& T_odom_body) {
+  const std::size_t index = odometry_poses_.size();
+  if (index == 0) {
+    poses_.push_back(T_odom_body);
+    path_lengths_m_.push_back(0.0);
+  } else {
+    const lie::SE3 T_prev_this = odometry_poses_.back().inverse() * T_odom_body;
+    poses_.push_back(poses_.back() * T_prev_this);
+    path_lengths_m_.push_back(path_lengths_m_.back() + T_prev_this.translation().norm());
+  }
+  odometry_poses_.push_back(T_odom_body);
+  return index;
+}
+
+RelativePose PoseGraph::odometryBetween(std::size_t from, std::size_t to) const {
+  const lie::SE3 T_from_to = odometry_poses_[from].inverse() * odometry_poses_[to];
+  const double distance_m = T_from_to.translation().norm();
+  const double sigma_m = config_.odometry_sigma_m + config_.odometry_sigma_m_per_m * distance_m;
+  const double sigma_rad =
+      config_.odometry_sigma_rad + config_.odometry_sigma_rad_per_m * distance_m;
+  lie::Vector6 variances;
+  variances << lie::Vector3::Constant(sigma_m * sigma_m),
+      lie::Vector3::Constant(sigma_rad * sigma_rad);
+  return {from, to, T_from_to, variances.asDiagonal().toDenseMatrix()};
+}
+
+void PoseGraph::changeWorldFrame(const lie::SE3& T_new_old) {
+  for (lie::SE3& pose : odometry_poses_) pose = T_new_old * pose;
+  for (lie::SE3& pose : poses_) pose = T_new_old * pose;
+}
+
+void PoseGraph::addLoop(const RelativePose& loop) { loops_.push_back(loop); }
+
+double PoseGraph::addLoopIfConsistent(const RelativePose& loop, double max_chi2) {
+  PoseGraph trial = *this;
+  trial.addLoop(loop);
+  const double chi2 = 2.0 * (trial.optimize() - cost_);
+  if (chi2 <= max_chi2) *this = std::move(trial);
+  return chi2;
+}
+
+void PoseGraph::addPosition(std::size_t keyframe, const Eigen::Vector3d& p_world,
+                            const Eigen::Matrix3d& covariance, double huber_sigmas) {
+  positions_.push_back({keyframe, p_world, covariance, huber_sigmas});
+}
+
+double PoseGraph::mahalanobis2(const RelativePose& measurement) const {
+  const backend::RelativePoseFactor factor(measurement.T_from_to, measurement.covariance);
+  const lie::Vector6 error = factor.error(poses_[measurement.from], poses_[measurement.to]);
+  return error.dot(measurement.covariance.ldlt().solve(error));
+}
+
+double PoseGraph::optimize() {
+  if (size() < 2) return 0.0;
+  std::vector<PoseBlock> blocks;
+  blocks.reserve(size());
+  for (const lie::SE3& pose : poses_) blocks.push_back(toBlock(pose));
+
+  // The problem owns the factors and the loss functions; the manifold is shared.
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  backend::PoseManifold manifold;
+  for (PoseBlock& block : blocks) problem.AddParameterBlock(block.data(), backend::kPoseSize, &manifold);
+  auto addRelative = [&](const RelativePose& relative) {
+    problem.AddResidualBlock(
+        new backend::RelativePoseFactor(relative.T_from_to, relative.covariance), nullptr,
+        blocks[relative.from].data(), blocks[relative.to].data());
+  };
+  for (std::size_t k = 1; k < size(); ++k) addRelative(odometryBetween(k - 1, k));
+  for (const RelativePose& loop : loops_) addRelative(loop);
+  for (const Position& position : positions_) {
+    ceres::LossFunction* loss =
+        position.huber_sigmas > 0.0 ? new ceres::HuberLoss(position.huber_sigmas) : nullptr;
+    problem.AddResidualBlock(new backend::PositionFactor(position.p_world, position.covariance),
+                             loss, blocks[position.keyframe].data());
+  }
+  if (positions_.empty()) problem.SetParameterBlockConstant(blocks.front().data());
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = 50;
+  options.num_threads = 1;  // the same answer every time
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  for (std::size_t k = 0; k < size(); ++k) poses_[k] = fromBlock(blocks[k]);
+  cost_ = summary.final_cost;
+  return cost_;
+}
+
+}  // namespace taiga::mapping
