@@ -90,6 +90,10 @@ TEST(OdometryScenario, HandheldWalkWithImuOrientationStaysWithinCentimetresAndRe
             readFile(dir.path() / "rerun" / "trajectory.tum"));
   EXPECT_EQ(readFile(dir.path() / "run" / "trajectory_imu.tum"),
             readFile(dir.path() / "rerun" / "trajectory_imu.tum"));
+  // The map, exported from the keyframe store at the end of the run, too.
+  EXPECT_EQ(readFile(dir.path() / "run" / "map.las"), readFile(dir.path() / "rerun" / "map.las"));
+  EXPECT_EQ(readFile(dir.path() / "run" / "keyframes" / "poses.tum"),
+            readFile(dir.path() / "rerun" / "keyframes" / "poses.tum"));
 }
 
 // A 6-axis IMU (the Ouster's own) that starts moving: the tilt from the mean specific force is
