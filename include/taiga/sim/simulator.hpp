@@ -10,6 +10,7 @@
 //   georef_truth.yaml  the world frame in EPSG:3067 (origin, rotation, scale, T_epsg_world);
 //                      written first: an unknown gnss.georef_epsg fails before the recording
 //   scenario.yaml      the effective scenario (taiga simulate --overrides scenario.yaml redoes it)
+//   reference_cloud.las  on request (reference_cloud.hpp): a dense noise-free TLS cloud
 
 #include <cstdint>
 #include <filesystem>
