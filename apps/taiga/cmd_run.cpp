@@ -37,7 +37,8 @@ int run(const RunOptions& options) {
       "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {:.2f}x real time; peak "
       "memory {:.0f} MB\n",
       s.mean_ms, s.p95_ms, s.max_ms, s.realtime_factor, s.peak_memory_mb);
-  fmt::print("map        exported in {:.1f} s after the run\n", s.map_export_s);
+  fmt::print("mapping    {} loop closures (loops.csv); map exported in {:.1f} s after the run\n",
+             s.loop_closures, s.map_export_s);
   if (s.realtime) {
     fmt::print("realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "
                "{:.1f} ms max from delivery to pose\n",
@@ -45,8 +46,8 @@ int run(const RunOptions& options) {
                s.realtime->latency_max_ms);
   }
   fmt::print(
-      "outputs    {}/ (trajectory.tum, trajectory_imu.tum, keyframes.tum, keyframes/, map.las{}, "
-      "timing.csv, scans.csv, summary.json)\n",
+      "outputs    {}/ (trajectory.tum, trajectory_imu.tum, trajectory_odometry.tum, keyframes.tum, "
+      "keyframes/, map.las{}, loops.csv, timing.csv, scans.csv, summary.json)\n",
       options.out, options.ply ? ", map.ply" : "");
   return kExitOk;
 }

@@ -42,6 +42,9 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.field("local_map_keyframes", local_map_keyframes, "keyframes held in the local map");
   v.field("lidar_sigma", lidar_sigma,
           "m and rad, sigma of the lidar factor at good fitness (thesis sigma_sm)");
+  v.field("lidar_heading_sigma_rad", lidar_heading_sigma_rad,
+          "rad, sigma of the lidar factor's heading (about the vertical) at good fitness; 0: "
+          "lidar_sigma (the thesis uses one sigma for all six axes)");
   v.field("fitness_threshold_m2", fitness_threshold_m2,
           "m^2, fitness above which the sigma grows (thesis tau_fs)");
   v.field("fitness_sigma_exponent", fitness_sigma_exponent,
@@ -72,6 +75,7 @@ void OdometryConfig::validate() const {
   requireInRange("local_map_voxel_m", local_map_voxel_m, 0.01, 5.0, "m");
   requireInRange("local_map_keyframes", local_map_keyframes, 1, 1000, "keyframes");
   requirePositive("lidar_sigma", lidar_sigma, "m");
+  requireNonNegative("lidar_heading_sigma_rad", lidar_heading_sigma_rad, "rad");
   requirePositive("fitness_threshold_m2", fitness_threshold_m2, "m^2");
   requireNonNegative("fitness_sigma_exponent", fitness_sigma_exponent, "");
   requirePositive("max_fitness_m2", max_fitness_m2, "m^2");

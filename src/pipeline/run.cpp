@@ -20,6 +20,8 @@
 #include "taiga/io/moving_boxes.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
+#include "taiga/mapping/mapper.hpp"
+#include "taiga/mapping/trajectory_correction.hpp"
 #include "taiga/mapping/map_export.hpp"
 #include "taiga/pipeline/lidar_inertial_odometry.hpp"
 
@@ -69,7 +71,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"scans_processed", s.scans_processed},
       {"imu_samples", s.imu_samples},
       {"keyframes", s.keyframes},
-      {"loop_closures", 0},
+      {"loop_closures", s.loop_closures},
       {"registration_failures", s.lidar_rejected},
       {"lidar_factors_inflated", s.lidar_inflated},
       {"map_points", s.map_points},
@@ -119,11 +121,19 @@ std::vector<lie::SE3> transformedPoses(const std::vector<lie::SE3>& poses, const
   return out;
 }
 
-// The one place that decides which keyframe poses the outputs (map.las, keyframes.tum,
-// keyframes/poses.tum) are built from. Today: the odometry's poses at the keyframes, re-expressed
-// in the levelled world frame. The mapping graph (issue 7) puts its optimized poses here.
-std::vector<lie::SE3> finalKeyframePoses(const mapping::KeyframeStore& keyframe_store) {
-  return keyframe_store.poses();
+// loops.csv: every loop closure attempt, accepted or not, and why.
+void writeLoops(const std::filesystem::path& path,
+                const std::vector<mapping::LoopRecord>& attempts) {
+  std::ofstream out = openOutput(path);
+  out << "t_s,keyframe,candidate,distance_m,search_radius_m,fitness_m2,correction_m,correction_"
+         "deg,chi2,accepted,note\n";
+  for (const mapping::LoopRecord& record : attempts) {
+    const mapping::LoopAttempt& a = record.attempt;
+    out << fmt::format("{:.6f},{},{},{:.3f},{:.3f},{:.5f},{:.4f},{:.4f},{:.2f},{},\"{}\"\n",
+                       record.t_s, a.current, a.candidate.keyframe, a.candidate.distance_m,
+                       a.candidate.search_radius_m, a.registration.fitness_m2, a.correction_m,
+                       a.correction_deg, record.chi2, a.accepted ? 1 : 0, a.note);
+  }
 }
 
 }  // namespace
@@ -152,7 +162,13 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
            "points,keyframe,note\n";
   // Keyframe scans go to disk in the body frame as they are made (memory stays flat); the map is
   // exported from them at the end, with the final poses.
-  mapping::KeyframeStore keyframe_store = mapping::KeyframeStore::create(options.out_dir / "keyframes");
+  // Loop closure registers each keyframe's registration-resolution copy, kept in RAM.
+  mapping::KeyframeStore keyframe_store = mapping::KeyframeStore::create(
+      options.out_dir / "keyframes", {.registration_voxel_m = config.odometry.voxel_size_m});
+  // The mapping graph runs beside the odometry and corrects the keyframe poses at the end. The
+  // odometry does not wait for it, and its trajectory does not depend on it.
+  mapping::MappingThread mapping_thread(config.mapping, config.odometry, keyframe_store);
+  std::vector<double> keyframe_times_s;
 
   Trajectory trajectory, trajectory_imu;
   RunSummary summary;
@@ -168,6 +184,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       trajectory = transformed(trajectory, T_new_old);
       trajectory_imu = transformed(trajectory_imu, T_new_old);
       keyframe_store.setPoses(transformedPoses(keyframe_store.poses(), T_new_old));
+      mapping_thread.changeWorldFrame(T_new_old);
     }
     appendIfLater(trajectory, outcome.t_s, outcome.T_world_body);
     for (const StampedPose& p : outcome.imu_rate_poses)
@@ -187,7 +204,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                          outcome.source_points, outcome.keyframe ? 1 : 0, outcome.lidar_note);
     if (outcome.keyframe_cloud_in_body &&
         (keyframe_store.empty() || outcome.t_s > keyframe_store.info(keyframe_store.size() - 1).t_s)) {
-      keyframe_store.add(outcome.t_s, outcome.T_world_body, *outcome.keyframe_cloud_in_body);
+      const std::uint64_t id =
+          keyframe_store.add(outcome.t_s, outcome.T_world_body, *outcome.keyframe_cloud_in_body);
+      mapping_thread.addKeyframe(id, outcome.t_s, outcome.T_world_body);
+      keyframe_times_s.push_back(outcome.t_s);
       ++summary.keyframes;
     }
   };
@@ -244,9 +264,16 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                     "lidar_only",
                     recording_path.string(), summary.scans, summary.imu_samples));
   }
-  io::writeTum(options.out_dir / "trajectory.tum", trajectory);
-  io::writeTum(options.out_dir / "trajectory_imu.tum", trajectory_imu);
-  const std::vector<lie::SE3> keyframe_poses = finalKeyframePoses(keyframe_store);
+  // The odometry as it ran online; then every pose corrected by the mapping graph.
+  const mapping::Mapper& mapper = mapping_thread.finish();
+  io::writeTum(options.out_dir / "trajectory_odometry.tum", trajectory);
+  io::writeTum(options.out_dir / "trajectory.tum",
+               mapping::correctedTrajectory(trajectory, mapper.graph(), keyframe_times_s));
+  io::writeTum(options.out_dir / "trajectory_imu.tum",
+               mapping::correctedTrajectory(trajectory_imu, mapper.graph(), keyframe_times_s));
+  writeLoops(options.out_dir / "loops.csv", mapper.loopAttempts());
+  summary.loop_closures = mapper.loopClosures();
+  const std::vector<lie::SE3>& keyframe_poses = mapper.graph().poses();
   keyframe_store.setPoses(keyframe_poses);
   keyframe_store.writePoses();
   io::writeTum(options.out_dir / "keyframes.tum", keyframe_store.trajectory());

@@ -34,7 +34,8 @@ struct OdometryConfig final : ConfigSection {
   double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
   int local_map_keyframes = 20;            ///< keyframes the local map holds
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
-  double lidar_sigma = 0.01;            ///< sigma_sm: m and rad, at good fitness
+  double lidar_sigma = 0.01;            ///< sigma_sm: m and rad (roll, pitch; heading unless set below), at good fitness
+  double lidar_heading_sigma_rad = 0.003;  ///< heading sigma at good fitness; 0: lidar_sigma
   double fitness_threshold_m2 = 0.3;    ///< tau_fs
   double fitness_sigma_exponent = 2.0;  ///< theta_smsc
   // Rejection of registrations that disagree with the IMU prediction or did not work.

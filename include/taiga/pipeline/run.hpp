@@ -1,8 +1,11 @@
 #pragma once
 // `taiga run`: the odometry over a whole recording, with the outputs of DESIGN.md section 4:
-//   trajectory.tum       one pose per scan (T_world_body at the scan's end)
-//   trajectory_imu.tum   IMU-rate poses (propagated between scans, as published live)
-//   keyframes.tum        the keyframe poses
+//   trajectory.tum       one pose per scan (T_world_body at the scan's end), corrected by the
+//                        mapping graph (loop closures)
+//   trajectory_imu.tum   IMU-rate poses (propagated between scans), corrected likewise
+//   trajectory_odometry.tum  the odometry's per-scan poses as published live, uncorrected
+//   keyframes.tum        the keyframe poses optimized by the mapping graph
+//   loops.csv            every loop closure attempt: candidate, fitness, correction, verdict
 //   keyframes/           every keyframe's full deskewed scan in the body frame (NNNNNN.tkf,
 //                        mapping/keyframe_file.hpp), written as keyframes are made so memory
 //                        stays flat, and their final poses (poses.tum): `taiga export-map`
@@ -51,6 +54,7 @@ struct RunSummary {
   std::size_t lidar_rejected = 0;
   std::size_t lidar_inflated = 0;
   std::size_t map_points = 0;
+  std::size_t loop_closures = 0;
   double duration_s = 0.0;  ///< recording time covered by the states
   double path_length_m = 0.0;
   double mean_ms = 0.0, median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;
