@@ -13,7 +13,9 @@
 #include "../support/temp_dir.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/eval/evaluate.hpp"
+#include "taiga/eval/map_sharpness.hpp"
 #include "taiga/io/config_yaml.hpp"
+#include "taiga/io/las_reader.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/pipeline/run.hpp"
 #include "taiga/sim/simulator.hpp"
@@ -28,6 +30,7 @@ std::string readFile(const std::filesystem::path& path) {
 
 struct ScenarioRun {
   RunSummary summary;
+  eval::MapSharpness map_sharpness;  ///< map.las against the simulated scene
   eval::EvalResult evaluation;           ///< trajectory.tum: corrected by the mapping graph
   eval::EvalResult odometry_evaluation;  ///< trajectory_odometry.tum: the odometry alone
 };
@@ -53,6 +56,15 @@ ScenarioRun simulateAndRun(const std::string& scenario_name, double duration_s, 
   run.evaluation = eval::evaluate(io::readTum(dir / "run" / "trajectory.tum"), truth, {});
   run.odometry_evaluation =
       eval::evaluate(io::readTum(dir / "run" / "trajectory_odometry.tum"), truth, {});
+  // Map sharpness (issue 7): 100k points of map.las, in the truth frame by the ATE's alignment.
+  io::LasReader map(dir / "run" / "map.las");
+  const PointCloud sample = map.readStrided(std::max<std::uint64_t>(1, map.pointCount() / 100000));
+  run.map_sharpness = eval::computeMapSharpness(
+      sample.positions, map.pointCount(), run.evaluation.transform,
+      [&](const Eigen::Vector3d& p_ref, double max_m) {
+        return simulation.scene().distanceToSurface(p_ref, max_m);
+      });
+  ::testing::Test::RecordProperty("map_sharpness_rms_m", std::to_string(run.map_sharpness.rms_m));
   ::testing::Test::RecordProperty("ape_rmse_m",
                                   std::to_string(run.evaluation.ape.translation_m.rmse));
   ::testing::Test::RecordProperty("drift_percent",
@@ -152,6 +164,7 @@ TEST(OdometryScenario, HandheldLoopOfThreeMinutes) {
   EXPECT_LT(run.evaluation.drift.drift_m, 0.05);
   EXPECT_LT(run.evaluation.ape.translation_m.rmse, run.odometry_evaluation.ape.translation_m.rmse);
   EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.07);
+  EXPECT_LT(run.map_sharpness.rms_m, 0.04);
 }
 
 // Issue 6: no divergence and ATE <= 15 cm through vibration bursts and long stops. The crane's
