@@ -1,6 +1,8 @@
 #include "taiga/core/odometry_config.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace taiga {
 
@@ -65,6 +67,13 @@ void OdometryConfig::visit(ConfigVisitor& v) {
           "s, span of the first scans used to level the world frame with lidar and IMU (0: IMU "
           "attitude only)");
   v.section("imu", imu, "IMU noise model");
+}
+
+LidarSigmas OdometryConfig::lidarSigmas(double fitness_m2, double inflation) const {
+  const double ratio = std::max(1.0, fitness_m2 / fitness_threshold_m2);
+  const double growth = std::pow(ratio, fitness_sigma_exponent) * inflation;
+  const double heading_rad = lidar_heading_sigma_rad > 0.0 ? lidar_heading_sigma_rad : lidar_sigma;
+  return {lidar_sigma * growth, lidar_sigma * growth, heading_rad * growth};
 }
 
 void OdometryConfig::validate() const {

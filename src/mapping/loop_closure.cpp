@@ -80,16 +80,12 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   } else {
     attempt.accepted = true;
   }
-  // Thesis Eq. 36, as for the odometry's lidar factor (docs/odometry.md).
-  const double ratio = std::max(1.0, r.fitness_m2 / odometry.fitness_threshold_m2);
-  const double growth = std::pow(ratio, odometry.fitness_sigma_exponent);
-  const double sigma_m = odometry.lidar_sigma * growth;
-  const double sigma_rad = (odometry.lidar_heading_sigma_rad > 0.0 ? odometry.lidar_heading_sigma_rad
-                                                                   : odometry.lidar_sigma) *
-                           growth;
+  // Thesis Eq. 36 as for the odometry's lidar factor, with the heading sigma on all three
+  // rotation axes: the odometry chain between the keyframes holds roll and pitch (gravity).
+  const LidarSigmas sigma = odometry.lidarSigmas(r.fitness_m2);
   lie::Vector6 variances;
-  variances << lie::Vector3::Constant(sigma_m * sigma_m),
-      lie::Vector3::Constant(sigma_rad * sigma_rad);
+  variances << lie::Vector3::Constant(sigma.translation_m * sigma.translation_m),
+      lie::Vector3::Constant(sigma.heading_rad * sigma.heading_rad);
   attempt.loop = RelativePose{candidate.keyframe, current, r.T_target_source,
                               variances.asDiagonal().toDenseMatrix()};
   return attempt;

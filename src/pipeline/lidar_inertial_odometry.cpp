@@ -364,13 +364,12 @@ std::optional<backend::PoseMeasurement> LidarInertialOdometry::judge(
     outcome.lidar_note = rejected;
     return std::nullopt;
   }
-  // Thesis Eq. 36, as we read it: sigma_sm while the fitness is below tau_fs, growing with the
-  // fitness ratio to the power theta_smsc above it (docs/odometry.md).
-  const double ratio = std::max(1.0, r.fitness_m2 / config_.fitness_threshold_m2);
-  double growth = std::pow(ratio, config_.fitness_sigma_exponent);
+  // Thesis Eq. 36 (OdometryConfig::lidarSigmas, docs/odometry.md), ten times wider when the
+  // registration did not converge or is degenerate.
+  double inflation = 1.0;
   outcome.lidar = LidarFactor::kUsed;
   if (!r.converged || r.hessian_condition > config_.degenerate_condition) {
-    growth *= 10.0;
+    inflation = 10.0;
     outcome.lidar = LidarFactor::kInflated;
     outcome.lidar_note =
         !r.converged ? "registration hit its iteration limit"
@@ -380,18 +379,14 @@ std::optional<backend::PoseMeasurement> LidarInertialOdometry::judge(
   // factor would hold on to a tilted local map. Heading has no such second source, so it gets its
   // own, tighter sigma (docs/odometry.md). The factor's rotation tangent is in the body frame:
   // Sigma_body = R^T Sigma_world R.
-  const double sigma_m = config_.lidar_sigma * growth;
-  const double sigma_tilt_rad = config_.lidar_sigma * growth;
-  const double sigma_heading_rad =
-      (config_.lidar_heading_sigma_rad > 0.0 ? config_.lidar_heading_sigma_rad
-                                             : config_.lidar_sigma) *
-      growth;
+  const LidarSigmas sigma = config_.lidarSigmas(r.fitness_m2, inflation);
   const Eigen::Matrix3d R_world_body = r.T_target_source.rotation().matrix();
-  const Eigen::Vector3d rotation_variances_world(
-      sigma_tilt_rad * sigma_tilt_rad, sigma_tilt_rad * sigma_tilt_rad,
-      sigma_heading_rad * sigma_heading_rad);
+  const Eigen::Vector3d rotation_variances_world(sigma.tilt_rad * sigma.tilt_rad,
+                                                 sigma.tilt_rad * sigma.tilt_rad,
+                                                 sigma.heading_rad * sigma.heading_rad);
   lie::Matrix6 covariance = lie::Matrix6::Zero();
-  covariance.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * sigma_m * sigma_m;
+  covariance.topLeftCorner<3, 3>() =
+      Eigen::Matrix3d::Identity() * sigma.translation_m * sigma.translation_m;
   covariance.bottomRightCorner<3, 3>() =
       R_world_body.transpose() * rotation_variances_world.asDiagonal() * R_world_body;
   return backend::PoseMeasurement{r.T_target_source, covariance};

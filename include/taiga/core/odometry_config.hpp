@@ -19,6 +19,14 @@ struct ImuNoiseConfig final : ConfigSection {
   void validate() const override;
 };
 
+/// Sigmas of a registration-based pose measurement (thesis Eq. 36, see OdometryConfig::
+/// lidarSigmas()).
+struct LidarSigmas {
+  double translation_m = 0.0;
+  double tilt_rad = 0.0;     ///< roll and pitch
+  double heading_rad = 0.0;  ///< about the vertical
+};
+
 struct OdometryConfig final : ConfigSection {
   // Preprocessing (thesis 3.1.1).
   double min_range_m = 1.0;  ///< returns closer than this (the operator, the rig) are dropped
@@ -53,6 +61,10 @@ struct OdometryConfig final : ConfigSection {
   /// alignment, imu/gravity_alignment.hpp), s; 0 keeps the attitude from the IMU alone.
   double gravity_alignment_s = 2.0;
   ImuNoiseConfig imu;
+
+  /// Thesis Eq. 36 as docs/odometry.md reads it: sigma_sm while the fitness is at most tau_fs,
+  /// times (fitness / tau_fs)^theta_smsc above it, times `inflation`; heading with its own sigma.
+  LidarSigmas lidarSigmas(double fitness_m2, double inflation = 1.0) const;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;
