@@ -21,9 +21,9 @@
 #include "taiga/io/moving_boxes.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
+#include "taiga/mapping/map_export.hpp"
 #include "taiga/mapping/mapper.hpp"
 #include "taiga/mapping/trajectory_correction.hpp"
-#include "taiga/mapping/map_export.hpp"
 #include "taiga/pipeline/lidar_inertial_odometry.hpp"
 
 namespace taiga::pipeline {
@@ -162,8 +162,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   scans << "t_s,scan,lidar_factor,fitness_m2,iterations,converged,inliers,hessian_condition,source_"
            "points,keyframe,note\n";
   // Keyframe scans go to disk in the body frame as they are made (memory stays flat); the map is
-  // exported from them at the end, with the final poses.
-  // Loop closure registers each keyframe's registration-resolution copy, kept in RAM.
+  // exported from them at the end, with the final poses. Only the registration-resolution copy
+  // that loop closure registers stays in RAM.
   mapping::KeyframeStore keyframe_store = mapping::KeyframeStore::create(
       options.out_dir / "keyframes", {.registration_voxel_m = config.odometry.voxel_size_m});
   // The mapping graph runs beside the odometry and corrects the keyframe poses at the end. The
