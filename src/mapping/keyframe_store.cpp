@@ -15,13 +15,12 @@ constexpr const char* kPosesFile = "poses.tum";
 std::shared_ptr<const PointCloud> registrationCopy(const PointCloud& cloud_in_body,
                                                    double voxel_m) {
   if (voxel_m <= 0.0) return std::make_shared<const PointCloud>();
-  PointCloud filtered = preprocess::voxelFilter(cloud_in_body, voxel_m);
-  // Registration needs positions only.
-  filtered.times_s.clear();
-  filtered.intensities.clear();
-  filtered.rings.clear();
-  filtered.columns.clear();
-  return std::make_shared<const PointCloud>(std::move(filtered));
+  const PointCloud filtered = preprocess::voxelFilter(cloud_in_body, voxel_m);
+  // Registration needs positions only. A fresh vector of the exact size: the filter's own keeps
+  // the capacity it grew to (up to twice its size), and a copy stays in RAM per keyframe.
+  auto positions_only = std::make_shared<PointCloud>();
+  positions_only->positions.assign(filtered.positions.begin(), filtered.positions.end());
+  return positions_only;
 }
 
 }  // namespace
