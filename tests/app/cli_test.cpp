@@ -1,10 +1,7 @@
 // The `taiga` command as users and scripts see it: exit codes, help, version and error messages.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -13,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/io/rosbag.hpp"
@@ -21,22 +19,8 @@ namespace {
 
 using ::testing::HasSubstr;
 
-struct Result {
-  int exit_code;
-  std::string output;  // standard output, and standard error unless dropped
-};
-
-Result runTaiga(const std::string& arguments, bool keep_stderr = true) {
-  const std::string command = std::string(TAIGA_EXECUTABLE) + " " + arguments + (keep_stderr ? " 2>&1" : " 2>/dev/null");
-  std::FILE* pipe = popen(command.c_str(), "r");
-  Result result{-1, ""};
-  if (!pipe) return result;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using Result = taiga::test::TaigaResult;
+using taiga::test::runTaiga;
 
 TEST(Cli, PrintsItsVersion) {
   const Result r = runTaiga("--version");

@@ -1,16 +1,15 @@
 // `taiga eval` and `taiga compare` as users run them: values, formats, plots and exit codes.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
 #include "taiga/io/trajectory_io.hpp"
 
@@ -19,24 +18,8 @@ namespace {
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 
-struct Result {
-  int exit_code;
-  std::string output;
-};
-
-Result runTaiga(const std::string& arguments, bool keep_stderr = true,
-                const std::string& environment = "") {
-  const std::string command = environment + " " + std::string(TAIGA_EXECUTABLE) + " " + arguments +
-                              (keep_stderr ? " 2>&1" : " 2>/dev/null");
-  std::FILE* pipe = popen(command.c_str(), "r");
-  Result result{-1, ""};
-  if (!pipe) return result;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using Result = taiga::test::TaigaResult;
+using taiga::test::runTaiga;
 
 // A curved 3D path of n poses at 10 Hz, shifted by `offset` (m); `scale` stretches positions.
 taiga::Trajectory path(std::size_t n, const Eigen::Vector3d& offset = Eigen::Vector3d::Zero(),

@@ -2,12 +2,10 @@
 // keyframe store, and a corrupt store reported with the file's name and exit code 2.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <string>
 
+#include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
 #include "taiga/io/las_reader.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
@@ -17,22 +15,8 @@ namespace {
 
 using ::testing::HasSubstr;
 
-struct Result {
-  int exit_code = -1;
-  std::string output;
-};
-
-Result runTaiga(const std::string& arguments) {
-  const std::string command = std::string(TAIGA_EXECUTABLE) + " " + arguments + " 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  Result result;
-  if (!pipe) return result;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using Result = test::TaigaResult;
+using test::runTaiga;
 
 TEST(ExportMapCli, WritesTheMapAgainWithTheStoredPosesAndDecimation) {
   test::TempDir dir;
