@@ -3,23 +3,6 @@
 #include <Eigen/Cholesky>
 
 namespace taiga::backend {
-namespace {
-
-// The pose block's tangent [dp (world); dtheta (body)] as an SE(3) right perturbation:
-// T Exp([R^T dp; dtheta]) to first order (see pose_factor.cpp).
-lie::Matrix6 blockTangentToSe3(const lie::SE3& T_world_body) {
-  lie::Matrix6 to_se3 = lie::Matrix6::Identity();
-  to_se3.topLeftCorner<3, 3>() = T_world_body.rotation().inverse().matrix();
-  return to_se3;
-}
-
-lie::SE3 poseOf(const double* block) {
-  StateBlocks state;
-  std::copy(block, block + kPoseSize, state.pose.begin());
-  return state.T_world_body();
-}
-
-}  // namespace
 
 RelativePoseFactor::RelativePoseFactor(const lie::SE3& T_i_j_measured,
                                        const lie::Matrix6& covariance)
@@ -32,8 +15,8 @@ lie::Vector6 RelativePoseFactor::error(const lie::SE3& T_world_i, const lie::SE3
 
 bool RelativePoseFactor::Evaluate(double const* const* parameters, double* residuals,
                                   double** jacobians) const {
-  const lie::SE3 T_world_i = poseOf(parameters[0]);
-  const lie::SE3 T_world_j = poseOf(parameters[1]);
+  const lie::SE3 T_world_i = poseFromBlock(parameters[0]);
+  const lie::SE3 T_world_j = poseFromBlock(parameters[1]);
   const lie::SE3 T_i_j = T_world_i.inverse() * T_world_j;
   const lie::Vector6 r = (T_j_i_measured_ * T_i_j).Log();
   Eigen::Map<lie::Vector6>{residuals} = sqrt_information_ * r;
@@ -46,12 +29,12 @@ bool RelativePoseFactor::Evaluate(double const* const* parameters, double* resid
     Eigen::Map<Eigen::Matrix<double, 6, kPoseSize, Eigen::RowMajor>> J(jacobians[0]);
     J.setZero();
     J.leftCols<6>() = -sqrt_information_ * Jr_inv * T_i_j.inverse().adjoint() *
-                      blockTangentToSe3(T_world_i);
+                      poseTangentToSe3(T_world_i);
   }
   if (jacobians[1]) {
     Eigen::Map<Eigen::Matrix<double, 6, kPoseSize, Eigen::RowMajor>> J(jacobians[1]);
     J.setZero();
-    J.leftCols<6>() = sqrt_information_ * Jr_inv * blockTangentToSe3(T_world_j);
+    J.leftCols<6>() = sqrt_information_ * Jr_inv * poseTangentToSe3(T_world_j);
   }
   return true;
 }

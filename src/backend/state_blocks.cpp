@@ -39,8 +39,21 @@ imu::ImuBias StateBlocks::bias() const {
           Eigen::Map<const Eigen::Vector3d>(motion.data() + 6)};
 }
 
-lie::SE3 StateBlocks::T_world_body() const {
-  return lie::SE3(rotationOf(pose.data()), Eigen::Map<const Eigen::Vector3d>(pose.data()));
+lie::SE3 StateBlocks::T_world_body() const { return poseFromBlock(pose.data()); }
+
+lie::SE3 poseFromBlock(const double* pose_block) {
+  return lie::SE3(rotationOf(pose_block), Eigen::Map<const Eigen::Vector3d>(pose_block));
+}
+
+void writePoseBlock(const lie::SE3& T_world_body, double* pose_block) {
+  Eigen::Map<Eigen::Vector3d>{pose_block} = T_world_body.translation();
+  writeRotation(T_world_body.rotation(), pose_block);
+}
+
+lie::Matrix6 poseTangentToSe3(const lie::SE3& T_world_body) {
+  lie::Matrix6 to_se3 = lie::Matrix6::Identity();
+  to_se3.topLeftCorner<3, 3>() = T_world_body.rotation().inverse().matrix();
+  return to_se3;
 }
 
 bool PoseManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {

@@ -16,18 +16,6 @@ namespace {
 
 using PoseBlock = std::array<double, backend::kPoseSize>;
 
-PoseBlock toBlock(const lie::SE3& T_world_body) {
-  const Eigen::Quaterniond q = T_world_body.rotation().quaternion();
-  const Eigen::Vector3d& p = T_world_body.translation();
-  return {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
-}
-
-lie::SE3 fromBlock(const PoseBlock& block) {
-  backend::StateBlocks state;
-  state.pose = block;
-  return state.T_world_body();
-}
-
 }  // namespace
 
 PoseGraph::PoseGraph(const MappingConfig& config) : config_(config) {}
@@ -88,14 +76,16 @@ double PoseGraph::optimize() {
   if (size() < 2) return 0.0;
   std::vector<PoseBlock> blocks;
   blocks.reserve(size());
-  for (const lie::SE3& pose : poses_) blocks.push_back(toBlock(pose));
+  for (const lie::SE3& pose : poses_)
+    backend::writePoseBlock(pose, blocks.emplace_back().data());
 
   // The problem owns the factors and the loss functions; the manifold is shared.
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   backend::PoseManifold manifold;
-  for (PoseBlock& block : blocks) problem.AddParameterBlock(block.data(), backend::kPoseSize, &manifold);
+  for (PoseBlock& block : blocks)
+    problem.AddParameterBlock(block.data(), backend::kPoseSize, &manifold);
   auto addRelative = [&](const RelativePose& relative) {
     problem.AddResidualBlock(
         new backend::RelativePoseFactor(relative.T_from_to, relative.covariance), nullptr,
@@ -118,7 +108,7 @@ double PoseGraph::optimize() {
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  for (std::size_t k = 0; k < size(); ++k) poses_[k] = fromBlock(blocks[k]);
+  for (std::size_t k = 0; k < size(); ++k) poses_[k] = backend::poseFromBlock(blocks[k].data());
   cost_ = summary.final_cost;
   return cost_;
 }

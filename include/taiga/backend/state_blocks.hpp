@@ -33,6 +33,15 @@ struct StateBlocks {
   lie::SE3 T_world_body() const;
 };
 
+/// The T_world_body held in a pose block (7 doubles, layout above).
+lie::SE3 poseFromBlock(const double* pose_block);
+/// Writes T_world_body into a pose block.
+void writePoseBlock(const lie::SE3& T_world_body, double* pose_block);
+/// The pose block's tangent [dp; dtheta] as an SE(3) right perturbation at T_world_body, to first
+/// order: T Exp([R^T dp; dtheta]), i.e. blockdiag(R^T, I). Factors whose residual is written in
+/// the SE(3) tangent multiply their Jacobians by it.
+lie::Matrix6 poseTangentToSe3(const lie::SE3& T_world_body);
+
 class PoseManifold final : public ceres::Manifold {
  public:
   int AmbientSize() const override { return kPoseSize; }
