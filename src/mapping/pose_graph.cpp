@@ -66,12 +66,6 @@ void PoseGraph::addPosition(std::size_t keyframe, const Eigen::Vector3d& p_world
   positions_.push_back({keyframe, p_world, covariance, huber_sigmas});
 }
 
-double PoseGraph::mahalanobis2(const RelativePose& measurement) const {
-  const backend::RelativePoseFactor factor(measurement.T_from_to, measurement.covariance);
-  const lie::Vector6 error = factor.error(poses_[measurement.from], poses_[measurement.to]);
-  return error.dot(measurement.covariance.ldlt().solve(error));
-}
-
 double PoseGraph::optimize() {
   if (size() < 2) return 0.0;
   std::vector<PoseBlock> blocks;

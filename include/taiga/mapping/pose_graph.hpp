@@ -66,9 +66,6 @@ class PoseGraph {
   double pathLength(std::size_t keyframe) const { return path_lengths_m_[keyframe]; }
   const std::vector<RelativePose>& loops() const { return loops_; }
 
-  /// Squared Mahalanobis distance of a relative pose measurement from the current estimate.
-  double mahalanobis2(const RelativePose& measurement) const;
-
  private:
   struct Position {
     std::size_t keyframe;
