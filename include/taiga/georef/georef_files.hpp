@@ -1,0 +1,53 @@
+#pragma once
+// File input and output of `taiga georef` (docs/georeferencing.md has the formats). The fitting
+// code (fit.hpp) does no I/O; these functions do only I/O and formatting.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "taiga/core/sensor_samples.hpp"
+#include "taiga/core/system_config.hpp"
+#include "taiga/georef/fit.hpp"
+#include "taiga/georef/fix_preparation.hpp"
+#include "taiga/georef/grid_output.hpp"
+
+namespace taiga::georef {
+
+/// Fixes CSV: a header line naming the columns, then one fix per line. Required columns t_s,
+/// latitude_deg, longitude_deg, height_m (ellipsoidal); optional sigma_east_m, sigma_north_m,
+/// sigma_up_m (1-sigma, all three or none) and status (-1 no fix, 0 fix, 1 SBAS, 2 GBAS; 0 when
+/// absent). Lines starting with '#' and blank lines are ignored. InputError "FILE:LINE: ..."
+/// naming the column on malformed input.
+std::vector<GnssFix> readFixesCsv(const std::filesystem::path& path);
+
+/// What a recording holds for georeferencing.
+struct GnssInput {
+  std::vector<GnssFix> fixes;
+  std::vector<ImuSample> imu_with_orientation;  ///< IMU samples that carry an orientation
+  bool from_recording = false;
+};
+
+/// A CSV file (by the .csv extension) or a recording (openRecording with `config`).
+GnssInput readGnssInput(const std::filesystem::path& path, const SystemConfig& config);
+
+/// Everything georef.yaml reports.
+struct GeorefReport {
+  std::string method;
+  int epsg = 3067;
+  std::string crs_name;
+  std::string trajectory_file, gnss_file;
+  geo::Geodetic origin;
+  Eigen::Vector3d origin_grid = Eigen::Vector3d::Zero();  ///< E, N, h of the ENU origin
+  GeorefFit fit;
+  Eigen::Matrix4d T_epsg_world = Eigen::Matrix4d::Identity();
+  std::size_t fixes_total = 0, gated_no_fix = 0, gated_sigma = 0, gated_invalid = 0;
+  std::size_t outside_span = 0, in_gap = 0, associated = 0;
+};
+
+void writeGridCsv(const std::filesystem::path& path, const std::vector<GridPose>& poses);
+void writeGeoJson(const std::filesystem::path& path, const std::vector<GridPose>& poses, int epsg,
+                  const std::string& name);
+void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& report);
+
+}  // namespace taiga::georef

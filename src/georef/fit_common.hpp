@@ -1,0 +1,32 @@
+#pragma once
+// Helpers shared by the fitting methods (private to src/georef).
+
+#include <string_view>
+#include <vector>
+
+#include "taiga/georef/fit.hpp"
+#include "taiga/georef/residuals.hpp"
+
+namespace taiga::georef::detail {
+
+/// InputError unless there are at least 3 pairs and the antenna positions span more than a line
+/// (needs_3d: the second-largest spread) or, for the horizontal-only fit, more than a point
+/// horizontally.
+void requireGeometry(const std::vector<AssociatedFix>& pairs, std::string_view method,
+                     bool needs_3d);
+
+/// Spread of the antenna positions across their main direction (sqrt of the second-largest
+/// eigenvalue of their scatter), m: near zero when they lie on a line.
+double spreadAcrossLine(const std::vector<AssociatedFix>& pairs);
+
+/// Fills the residual statistics (over the inliers), inlier counts and sigma from covariance.
+void finishFit(const std::vector<AssociatedFix>& pairs, GeorefFit& fit);
+
+/// Unweighted rigid fit of p_world onto p_enu over the pairs with use[i] (Umeyama, no scale).
+lie::SE3 rigidFit(const std::vector<AssociatedFix>& pairs, const std::vector<bool>& use);
+
+/// The inverse of a symmetric positive semi-definite normal matrix (LDLT; Eigen's inverse of the
+/// decomposition, deterministic).
+Matrix6d inverseNormal(const Matrix6d& H);
+
+}  // namespace taiga::georef::detail

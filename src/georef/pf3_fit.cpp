@@ -1,0 +1,63 @@
+// pf3: the thesis' ICP-like fit of positions with time-interpolated correspondences (the
+// association), Gauss-Newton on the 6 parameters of T_enu_world. Each residual
+// r_i = R p_world,i + t - p_enu,i is weighted by the inverse of the combined covariance
+// (thesis Eq. 44)
+//   Sigma_i = Sigma_gnss,i + R Sigma_traj R^T,
+// recomputed with the current R every iteration. Normal equations H delta = -b with
+// H = sum J_i^T Sigma_i^-1 J_i, b = sum J_i^T Sigma_i^-1 r_i (J_i in residuals.hpp). Covariance:
+// sigma0^2 H^-1 with the variance factor sigma0^2 = sum r_i^T Sigma_i^-1 r_i / (3n - 6).
+#include "fit_common.hpp"
+
+namespace taiga::georef {
+
+GeorefFit fitPf3(const std::vector<AssociatedFix>& pairs, const FitOptions& options) {
+  options.validate();
+  detail::requireGeometry(pairs, "pf3", /*needs_3d=*/true);
+  GeorefFit fit;
+  fit.method = GeorefMethod::kPf3;
+  fit.inlier.assign(pairs.size(), true);
+  fit.T_enu_world = detail::rigidFit(pairs, fit.inlier);
+  const Eigen::Matrix3d sigma_traj_world =
+      options.trajectory_position_sigma_m * options.trajectory_position_sigma_m *
+      Eigen::Matrix3d::Identity();
+
+  // One linearization at T: the normal matrix, gradient and weighted squared residual sum.
+  struct Normal {
+    Matrix6d H = Matrix6d::Zero();
+    Vector6d b = Vector6d::Zero();
+    double chi2 = 0.0;
+  };
+  const auto linearize = [&](const lie::SE3& T) -> Normal {
+    Normal normal;
+    const Eigen::Matrix3d R = T.rotation().matrix();
+    for (const AssociatedFix& pair : pairs) {
+      Matrix36d J;
+      const Eigen::Vector3d r = positionResidual(T, pair.p_world, pair.fix.p_enu, &J);
+      const Eigen::Matrix3d information =
+          (pair.fix.covariance_enu_m2 + R * sigma_traj_world * R.transpose()).inverse();
+      normal.H += J.transpose() * information * J;
+      normal.b += J.transpose() * information * r;
+      normal.chi2 += r.dot(information * r);
+    }
+    return normal;
+  };
+
+  fit.converged = false;
+  Normal normal = linearize(fit.T_enu_world);
+  for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
+    const Vector6d delta = -normal.H.ldlt().solve(normal.b);
+    fit.T_enu_world = applyUpdate(fit.T_enu_world, delta);
+    normal = linearize(fit.T_enu_world);
+    if (delta.norm() < options.convergence_step) {
+      fit.converged = true;
+      break;
+    }
+  }
+  fit.iterations = std::min(fit.iterations, options.max_iterations);
+  const double dof = 3.0 * static_cast<double>(pairs.size()) - 6.0;
+  fit.covariance = (normal.chi2 / dof) * detail::inverseNormal(normal.H);
+  detail::finishFit(pairs, fit);
+  return fit;
+}
+
+}  // namespace taiga::georef
