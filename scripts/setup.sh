@@ -16,7 +16,7 @@ packages=(
   # recordings: Ouster captures, ROS1 bags
   libpcap-dev librosbag-storage-dev libsensor-msgs-dev libstd-msgs-dev liblzf-dev
   # estimation, parallel loops, nearest neighbours, geodesy, ray casting for the simulator
-  libceres-dev libtbb-dev libnanoflann-dev libproj-dev proj-data libembree-dev
+  libceres-dev libtbb-dev libnanoflann-dev robin-map-dev libproj-dev proj-data libembree-dev
   # reference implementations (PCL's NDT/GICP) for tests and benchmarks, plots
   libpcl-dev python3-matplotlib
   # tests and benchmarks

@@ -7,6 +7,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include <tsl/robin_map.h>
+
+#include "taiga/core/hash.hpp"
+
 namespace taiga::preprocess {
 namespace {
 
@@ -29,34 +33,51 @@ PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m) {
   if (!(voxel_size_m > 0.0))
     throw std::invalid_argument("voxelFilter: voxel_size_m must be positive");
   const double inverse_size = 1.0 / voxel_size_m;
-  std::vector<std::pair<std::uint64_t, std::size_t>> keyed;
-  keyed.reserve(cloud.size());
+
+  // Points are gathered into cells through a hash map and only the cells are sorted by key: a
+  // scan has 5-10 times more points than occupied voxels, and sorting the points was the cost.
+  constexpr std::uint32_t kDropped = std::numeric_limits<std::uint32_t>::max();
+  struct Cell {
+    std::uint64_t key = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::size_t count = 0;
+    std::size_t nearest = 0;
+    double nearest_d2 = std::numeric_limits<double>::infinity();
+  };
+  std::vector<Cell> cells;
+  std::vector<std::uint32_t> cell_of_point(cloud.size(), kDropped);
+  tsl::robin_map<std::uint64_t, std::uint32_t, MixedKeyHash> cell_of_key;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (cloud.positions[i].allFinite())
-      keyed.emplace_back(voxelKey(cloud.positions[i], inverse_size), i);
+    const Eigen::Vector3d& p = cloud.positions[i];
+    if (!p.allFinite()) continue;
+    const std::uint64_t key = voxelKey(p, inverse_size);
+    auto [it, inserted] = cell_of_key.try_emplace(key, static_cast<std::uint32_t>(cells.size()));
+    if (inserted) cells.push_back(Cell{key});
+    Cell& cell = cells[it->second];
+    cell.sum += p;  // in point order, as the sorted version summed them
+    ++cell.count;
+    cell_of_point[i] = it->second;
   }
-  std::sort(keyed.begin(), keyed.end());
+  for (Cell& cell : cells) cell.sum /= static_cast<double>(cell.count);  // now the centroid
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (cell_of_point[i] == kDropped) continue;
+    Cell& cell = cells[cell_of_point[i]];
+    const double d2 = (cloud.positions[i] - cell.sum).squaredNorm();
+    if (d2 < cell.nearest_d2) {  // ties keep the lowest index
+      cell.nearest_d2 = d2;
+      cell.nearest = i;
+    }
+  }
+  std::sort(cells.begin(), cells.end(),
+            [](const Cell& a, const Cell& b) { return a.key < b.key; });
 
   std::vector<Eigen::Vector3d> centroids;
   std::vector<std::size_t> representatives;
-  for (std::size_t begin = 0; begin < keyed.size();) {
-    std::size_t end = begin;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    while (end < keyed.size() && keyed[end].first == keyed[begin].first)
-      sum += cloud.positions[keyed[end++].second];
-    const Eigen::Vector3d centroid = sum / static_cast<double>(end - begin);
-    std::size_t nearest = keyed[begin].second;
-    double nearest_d2 = std::numeric_limits<double>::infinity();
-    for (std::size_t k = begin; k < end; ++k) {
-      const double d2 = (cloud.positions[keyed[k].second] - centroid).squaredNorm();
-      if (d2 < nearest_d2) {
-        nearest_d2 = d2;
-        nearest = keyed[k].second;
-      }
-    }
-    centroids.push_back(centroid);
-    representatives.push_back(nearest);
-    begin = end;
+  centroids.reserve(cells.size());
+  representatives.reserve(cells.size());
+  for (const Cell& cell : cells) {
+    centroids.push_back(cell.sum);
+    representatives.push_back(cell.nearest);
   }
   PointCloud filtered = cloud.select(representatives);
   filtered.positions = std::move(centroids);

@@ -49,7 +49,7 @@ void VoxelStatistics::update(const Eigen::Vector3d& p, int sign) {
   if (sign < 0 && it == cells_.end()) {
     throw std::logic_error("VoxelStatistics::remove: a point that was never added");
   }
-  Sums& sums = sign > 0 ? cells_[key] : it->second;
+  Sums& sums = it != cells_.end() ? it.value() : cells_[key];
   sums.count += sign;
   for (int a = 0; a < 3; ++a) sums.s[a] += sign * q[a];
   sums.ss[0] += sign * q[0] * q[0];
@@ -75,16 +75,22 @@ std::size_t VoxelStatistics::numPoints() const {
   return n;
 }
 
+Eigen::Vector3d VoxelStatistics::meanOf(VoxelKey key, const Sums& sums) const {
+  const Eigen::Matrix<std::int64_t, 3, 1> index = unpackVoxel(key);
+  const Eigen::Vector3d centre = (index.cast<double>().array() + 0.5) * resolution_m_;
+  const Eigen::Vector3d s(static_cast<double>(sums.s[0]), static_cast<double>(sums.s[1]),
+                          static_cast<double>(sums.s[2]));
+  return centre + s * (kQuantum_m / static_cast<double>(sums.count));
+}
+
 CellMoments VoxelStatistics::momentsOf(VoxelKey key, const Sums& sums) const {
   CellMoments m;
   m.key = key;
   m.count = static_cast<std::size_t>(sums.count);
-  const Eigen::Matrix<std::int64_t, 3, 1> index = unpackVoxel(key);
   const double n = static_cast<double>(sums.count);
   const Eigen::Vector3d s(static_cast<double>(sums.s[0]), static_cast<double>(sums.s[1]),
                           static_cast<double>(sums.s[2]));
-  const Eigen::Vector3d centre = (index.cast<double>().array() + 0.5) * resolution_m_;
-  m.mean = centre + s * (kQuantum_m / n);
+  m.mean = meanOf(key, sums);
   if (sums.count >= 2) {
     Eigen::Matrix3d ss;
     ss << static_cast<double>(sums.ss[0]), static_cast<double>(sums.ss[1]),
@@ -98,21 +104,29 @@ CellMoments VoxelStatistics::momentsOf(VoxelKey key, const Sums& sums) const {
 }
 
 std::vector<CellMoments> VoxelStatistics::moments(std::size_t min_points) const {
-  std::vector<VoxelKey> keys;
-  keys.reserve(cells_.size());
+  // Sorting (key, sums) pairs instead of keys avoids a hash lookup per cell afterwards.
+  std::vector<std::pair<VoxelKey, const Sums*>> cells;
+  cells.reserve(cells_.size());
   for (const auto& [key, sums] : cells_) {
-    if (static_cast<std::size_t>(sums.count) >= min_points) keys.push_back(key);
+    if (static_cast<std::size_t>(sums.count) >= min_points) cells.emplace_back(key, &sums);
   }
-  std::sort(keys.begin(), keys.end());
+  std::sort(cells.begin(), cells.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<CellMoments> out;
-  out.reserve(keys.size());
-  for (VoxelKey key : keys) out.push_back(momentsOf(key, cells_.at(key)));
+  out.reserve(cells.size());
+  for (const auto& [key, sums] : cells) out.push_back(momentsOf(key, *sums));
   return out;
 }
 
 std::vector<Eigen::Vector3d> VoxelStatistics::means() const {
+  std::vector<std::pair<VoxelKey, Eigen::Vector3d>> cells;
+  cells.reserve(cells_.size());
+  for (const auto& [key, sums] : cells_) cells.emplace_back(key, meanOf(key, sums));
+  std::sort(cells.begin(), cells.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Eigen::Vector3d> out;
-  for (const CellMoments& m : moments(1)) out.push_back(m.mean);
+  out.reserve(cells.size());
+  for (const auto& cell : cells) out.push_back(cell.second);
   return out;
 }
 

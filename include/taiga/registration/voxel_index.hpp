@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "taiga/core/hash.hpp"
+
 namespace taiga::registration {
 
 /// A voxel (ix, iy, iz) packed into 63 bits, 21 per axis; valid for |i| < 2^20, i.e. up to
@@ -59,13 +61,7 @@ class VoxelIndex {
   }
 
  private:
-  static std::uint64_t hash(VoxelKey key) {
-    std::uint64_t x = static_cast<std::uint64_t>(key);
-    x ^= x >> 31;
-    x *= 0x9e3779b97f4a7c15ULL;
-    x ^= x >> 29;
-    return x;
-  }
+  static std::uint64_t hash(VoxelKey key) { return MixedKeyHash{}(static_cast<std::uint64_t>(key)); }
   std::vector<VoxelKey> keys_;
   std::vector<std::int32_t> values_;
   std::uint64_t mask_ = 0;
