@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "realtime_feed.hpp"
+#include "recording_feed.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/core/progress.hpp"
@@ -174,8 +174,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   Trajectory trajectory, trajectory_imu;
   RunSummary summary;
   std::vector<double> totals_ms;
-  // Reading and decoding the events since the previous scan (IMU readings included), charged to
-  // the scan; 0 under --realtime, where a reader thread does it.
+  // The reader thread's time to read and decode the events since the previous scan (IMU
+  // readings included), charged to the scan.
   double read_ms_since_scan = 0.0, scan_read_ms = 0.0;
   Progress progress("taiga run", 0, "scans", stderr,
                     options.show_progress && isatty(fileno(stderr)));
@@ -243,28 +243,26 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   odometry.setLidarOnly(lidar_only);
   for (const io::RecordingEvent& event : read_ahead) handle(event);
   read_ahead.clear();
-  if (options.realtime) {
-    std::vector<double> latencies_ms;
-    RealtimeFeed feed(recording, options.realtime_queue_scans);
-    while (std::optional<RealtimeFeed::Delivery> delivery = feed.next()) {
-      if (handle(delivery->event)) {
-        latencies_ms.push_back(
-            std::chrono::duration<double, std::milli>(Clock::now() - delivery->delivered).count());
-      }
+  // A reader thread reads and decodes ahead (at most a few scans), at sensor rate under
+  // --realtime. read_ms is its time, which now overlaps with the processing.
+  constexpr std::size_t kReadAheadScans = 3;
+  RecordingFeed feed(recording,
+                     options.realtime ? RecordingFeed::Pacing::kSensorRate
+                                      : RecordingFeed::Pacing::kAsFastAsPossible,
+                     options.realtime ? options.realtime_queue_scans : kReadAheadScans);
+  std::vector<double> latencies_ms;
+  while (std::optional<RecordingFeed::Delivery> delivery = feed.next()) {
+    read_ms_since_scan += delivery->read_ms;
+    if (handle(delivery->event)) {
+      latencies_ms.push_back(
+          std::chrono::duration<double, std::milli>(Clock::now() - delivery->delivered).count());
     }
+  }
+  if (options.realtime) {
     summary.realtime = RealtimeReport{.dropped_scans = feed.droppedScans(),
                                       .latency_p50_ms = percentile(latencies_ms, 0.5),
                                       .latency_p95_ms = percentile(latencies_ms, 0.95),
                                       .latency_max_ms = percentile(latencies_ms, 1.0)};
-  } else {
-    while (true) {
-      const auto read_start = Clock::now();
-      std::optional<io::RecordingEvent> event = recording.next();
-      read_ms_since_scan +=
-          std::chrono::duration<double, std::milli>(Clock::now() - read_start).count();
-      if (!event) break;
-      handle(*event);
-    }
   }
   progress.finish();
   // The mapping thread's last loop closures belong to the processing time; the export does not.

@@ -1,10 +1,13 @@
-// The --realtime replay: sensor-rate delivery into a bounded queue that drops the oldest scan
-// when the consumer falls behind, never an IMU reading, and passes the reader's errors on.
-#include "../../src/pipeline/realtime_feed.hpp"
+// The reader thread of taiga run: at sensor rate (--realtime) into a bounded queue that drops the
+// oldest scan when the consumer falls behind, never an IMU reading; as fast as possible without
+// dropping anything; and in both, the reader's errors passed on.
+#include "../../src/pipeline/recording_feed.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <thread>
+#include <vector>
 
 #include "taiga/core/errors.hpp"
 
@@ -45,9 +48,9 @@ io::Recording fakeRecording(double duration_s, int lidar_fail_after = -1) {
   return io::Recording("fake.bag", std::move(streams));
 }
 
-TEST(RealtimeFeed, ASlowConsumerLosesTheOldestScansButNoImuReading) {
+TEST(RecordingFeed, ASlowConsumerLosesTheOldestScansButNoImuReading) {
   io::Recording recording = fakeRecording(1.0);  // 11 scans, 101 IMU readings in 1 s
-  RealtimeFeed feed(recording, 2);
+  RecordingFeed feed(recording, RecordingFeed::Pacing::kSensorRate, 2);
   int scans = 0, imu = 0;
   std::uint64_t last_index = 0;
   while (auto delivery = feed.next()) {
@@ -69,22 +72,22 @@ TEST(RealtimeFeed, ASlowConsumerLosesTheOldestScansButNoImuReading) {
   EXPECT_EQ(last_index, 10u);  // the newest scan is never the one dropped
 }
 
-TEST(RealtimeFeed, DeliversAtSensorRate) {
+TEST(RecordingFeed, DeliversAtSensorRate) {
   io::Recording recording = fakeRecording(0.5);
-  const auto start = RealtimeFeed::Clock::now();
-  RealtimeFeed feed(recording, 2);
+  const auto start = RecordingFeed::Clock::now();
+  RecordingFeed feed(recording, RecordingFeed::Pacing::kSensorRate, 2);
   int events = 0;
   while (feed.next()) ++events;
   const double elapsed_s =
-      std::chrono::duration<double>(RealtimeFeed::Clock::now() - start).count();
+      std::chrono::duration<double>(RecordingFeed::Clock::now() - start).count();
   EXPECT_EQ(events, 6 + 51);
   EXPECT_GE(elapsed_s, 0.5);  // the last event is due 0.5 s after the first
   EXPECT_EQ(feed.droppedScans(), 0u);
 }
 
-TEST(RealtimeFeed, PassesTheReadersErrorOnAfterWhatItDelivered) {
+TEST(RecordingFeed, PassesTheReadersErrorOnAfterWhatItDelivered) {
   io::Recording recording = fakeRecording(1.0, 3);
-  RealtimeFeed feed(recording, 2);
+  RecordingFeed feed(recording, RecordingFeed::Pacing::kSensorRate, 2);
   int scans = 0;
   try {
     while (auto delivery = feed.next()) scans += std::holds_alternative<io::Scan>(delivery->event);
@@ -95,15 +98,53 @@ TEST(RealtimeFeed, PassesTheReadersErrorOnAfterWhatItDelivered) {
   EXPECT_EQ(scans, 3);
 }
 
-TEST(RealtimeFeed, StopsCleanlyWhenLeftEarly) {
+TEST(RecordingFeed, StopsCleanlyWhenLeftEarly) {
   io::Recording recording = fakeRecording(30.0);
-  const auto start = RealtimeFeed::Clock::now();
+  const auto start = RecordingFeed::Clock::now();
   {
-    RealtimeFeed feed(recording, 2);
+    RecordingFeed feed(recording, RecordingFeed::Pacing::kSensorRate, 2);
     ASSERT_TRUE(feed.next());
   }  // the destructor must not wait for the 30 s replay
-  EXPECT_LT(std::chrono::duration<double>(RealtimeFeed::Clock::now() - start).count(), 5.0);
+  EXPECT_LT(std::chrono::duration<double>(RecordingFeed::Clock::now() - start).count(), 5.0);
 }
+
+TEST(RecordingFeed, AsFastAsPossibleDeliversEveryEventInOrderToASlowConsumer) {
+  io::Recording recording = fakeRecording(1.0);  // 11 scans, 101 IMU readings in 1 s
+  const auto start = RecordingFeed::Clock::now();
+  RecordingFeed feed(recording, RecordingFeed::Pacing::kAsFastAsPossible, 2);
+  std::vector<double> times;
+  int scans = 0;
+  while (auto delivery = feed.next()) {
+    times.push_back(io::eventTime(delivery->event));
+    EXPECT_GE(delivery->read_ms, 0.0);
+    if (std::holds_alternative<io::Scan>(delivery->event) && ++scans <= 3) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the reader must wait, not drop
+    }
+  }
+  EXPECT_EQ(scans, 11);
+  EXPECT_EQ(times.size(), 11u + 101u);
+  EXPECT_TRUE(std::is_sorted(times.begin(), times.end()));
+  EXPECT_EQ(feed.droppedScans(), 0u);
+  // Not paced: the 1 s recording is through in the consumer's 150 ms plus reading.
+  EXPECT_LT(std::chrono::duration<double>(RecordingFeed::Clock::now() - start).count(), 0.9);
+}
+
+TEST(RecordingFeed, AsFastAsPossiblePassesTheReadersErrorOn) {
+  io::Recording recording = fakeRecording(1.0, 3);
+  RecordingFeed feed(recording, RecordingFeed::Pacing::kAsFastAsPossible, 1);
+  int scans = 0;
+  EXPECT_THROW(
+      while (auto delivery = feed.next()) scans += std::holds_alternative<io::Scan>(delivery->event),
+      InputError);
+  EXPECT_EQ(scans, 3);
+}
+
+TEST(RecordingFeed, StopsCleanlyWhenLeftEarlyWithAFullQueue) {
+  io::Recording recording = fakeRecording(30.0);
+  RecordingFeed feed(recording, RecordingFeed::Pacing::kAsFastAsPossible, 1);
+  ASSERT_TRUE(feed.next());
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the reader fills the queue
+}  // the destructor must wake the waiting reader, or this test hangs
 
 }  // namespace
 }  // namespace taiga::pipeline
