@@ -23,7 +23,7 @@ GeorefFit fitClosed(const std::vector<AssociatedFix>& pairs, const FitOptions& o
   const double dof = 3.0 * static_cast<double>(pairs.size()) - 6.0;
   fit.covariance = (sum_squares / dof) * detail::inverseNormal(H);
   fit.iterations = 1;
-  detail::finishFit(pairs, fit);
+  detail::finishFit(pairs, options, fit);
   return fit;
 }
 

@@ -44,6 +44,9 @@ void FitOptions::validate() const {
   positive(huber_threshold, "huber_threshold");
   positive(outlier_threshold, "outlier_threshold");
   positive(convergence_step, "convergence_step");
+  if (!(std::isfinite(error_correlation_time_s) && error_correlation_time_s >= 0.0))
+    throw std::invalid_argument(fmt::format(
+        "georef fit: error_correlation_time_s must be >= 0, got {}", error_correlation_time_s));
   if (max_iterations < 1) throw std::invalid_argument("georef fit: max_iterations must be >= 1");
 }
 

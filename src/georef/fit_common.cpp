@@ -52,7 +52,7 @@ void requireGeometry(const std::vector<AssociatedFix>& pairs, std::string_view m
   }
 }
 
-void finishFit(const std::vector<AssociatedFix>& pairs, GeorefFit& fit) {
+void finishFit(const std::vector<AssociatedFix>& pairs, const FitOptions& options, GeorefFit& fit) {
   double sum3 = 0.0, sum_h = 0.0, sum_v = 0.0;
   fit.inliers = 0;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
@@ -67,7 +67,21 @@ void finishFit(const std::vector<AssociatedFix>& pairs, GeorefFit& fit) {
   fit.residual_rms_m = std::sqrt(sum3 / n);
   fit.horizontal_rms_m = std::sqrt(sum_h / n);
   fit.vertical_rms_m = std::sqrt(sum_v / n);
-  fit.covariance = 0.5 * (fit.covariance + fit.covariance.transpose()).eval();
+  // Variance of the mean of m Gauss-Markov samples relative to white noise (fit.hpp).
+  fit.correlation_inflation = 1.0;
+  if (options.error_correlation_time_s > 0.0 && fit.inliers > 0) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      if (!fit.inlier[i]) continue;
+      for (std::size_t j = 0; j < pairs.size(); ++j) {
+        if (!fit.inlier[j]) continue;
+        sum += std::exp(-std::abs(pairs[i].fix.t_s - pairs[j].fix.t_s) /
+                        options.error_correlation_time_s);
+      }
+    }
+    fit.correlation_inflation = sum / static_cast<double>(fit.inliers);
+  }
+  fit.covariance = fit.correlation_inflation * 0.5 * (fit.covariance + fit.covariance.transpose());
   fit.sigma = fit.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 

@@ -19,8 +19,9 @@ void requireGeometry(const std::vector<AssociatedFix>& pairs, std::string_view m
 /// eigenvalue of their scatter), m: near zero when they lie on a line.
 double spreadAcrossLine(const std::vector<AssociatedFix>& pairs);
 
-/// Fills the residual statistics (over the inliers), inlier counts and sigma from covariance.
-void finishFit(const std::vector<AssociatedFix>& pairs, GeorefFit& fit);
+/// Fills the residual statistics (over the inliers) and inlier counts, inflates the covariance
+/// for correlated errors (fit.hpp) and takes the sigmas from it.
+void finishFit(const std::vector<AssociatedFix>& pairs, const FitOptions& options, GeorefFit& fit);
 
 /// Unweighted rigid fit of p_world onto p_enu over the pairs with use[i] (Umeyama, no scale).
 lie::SE3 rigidFit(const std::vector<AssociatedFix>& pairs, const std::vector<bool>& use);

@@ -5,7 +5,7 @@
 //   Sigma_i = Sigma_gnss,i + R Sigma_traj R^T,
 // recomputed with the current R every iteration. Normal equations H delta = -b with
 // H = sum J_i^T Sigma_i^-1 J_i, b = sum J_i^T Sigma_i^-1 r_i (J_i in residuals.hpp). Covariance:
-// sigma0^2 H^-1 with the variance factor sigma0^2 = sum r_i^T Sigma_i^-1 r_i / (3n - 6).
+// sigma0^2 H^-1 with the variance factor sigma0^2 = max(1, sum r_i^T Sigma_i^-1 r_i / (3n - 6)).
 #include "fit_common.hpp"
 
 namespace taiga::georef {
@@ -55,8 +55,8 @@ GeorefFit fitPf3(const std::vector<AssociatedFix>& pairs, const FitOptions& opti
   }
   fit.iterations = std::min(fit.iterations, options.max_iterations);
   const double dof = 3.0 * static_cast<double>(pairs.size()) - 6.0;
-  fit.covariance = (normal.chi2 / dof) * detail::inverseNormal(normal.H);
-  detail::finishFit(pairs, fit);
+  fit.covariance = std::max(1.0, normal.chi2 / dof) * detail::inverseNormal(normal.H);
+  detail::finishFit(pairs, options, fit);
   return fit;
 }
 

@@ -9,7 +9,7 @@
 // where Sigma_meas, in the measured body frame, rotates the ENU covariances of the position
 // (the fix's) and of the orientation (tilt, heading) by R_enu_body^T: blockdiag(R^T S_p R,
 // R^T S_theta R). Gauss-Newton (Eq. 48-52): H delta = -b, H = sum J^T Sigma_r^-1 J, with
-// J = d r / d delta (residuals.hpp); covariance sigma0^2 H^-1, sigma0^2 = chi2 / (6n - 6).
+// J = d r / d delta (residuals.hpp); covariance sigma0^2 H^-1, sigma0^2 = max(1, chi2 / (6n - 6)).
 #include <fmt/format.h>
 
 #include "fit_common.hpp"
@@ -105,8 +105,8 @@ GeorefFit fitPf6(const std::vector<AssociatedFix>& pairs,
   }
   fit.iterations = std::min(fit.iterations, options.max_iterations);
   const double dof = 6.0 * static_cast<double>(oriented.size()) - 6.0;
-  fit.covariance = (normal.chi2 / dof) * detail::inverseNormal(normal.H);
-  detail::finishFit(pairs, fit);
+  fit.covariance = std::max(1.0, normal.chi2 / dof) * detail::inverseNormal(normal.H);
+  detail::finishFit(pairs, options, fit);
   return fit;
 }
 

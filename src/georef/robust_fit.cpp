@@ -20,8 +20,9 @@
 // from the median; outliers as above.
 //
 // Uncertainty: (psi, t_e, t_n) from the weighted normal equations of the final fit scaled by the
-// variance factor sigma0^2 = sum w_i |r_i|^2 / s_i^2 / (2m - 3); t_u from
-// sigma0_u^2 / sum (w_i / sigma_up,i^2), sigma0_u^2 = sum w_i v_i^2 / (m - 1).
+// variance factor sigma0^2 = max(1, sum w_i |r_i|^2 / s_i^2 / (2m - 3)); t_u from
+// sigma0_u^2 / sum (w_i / sigma_up,i^2), sigma0_u^2 = max(1, sum w_i v_i^2 / (m - 1)); both then
+// inflated for correlated errors (fit.hpp).
 #include <algorithm>
 #include <cmath>
 
@@ -198,15 +199,16 @@ GeorefFit fitRobust(const std::vector<AssociatedFix>& pairs, const FitOptions& o
     ++m;
   }
   const Eigen::Matrix3d horizontal_covariance =
-      chi2 / std::max(1.0, 2.0 * static_cast<double>(m) - 3.0) *
+      std::max(1.0, chi2 / std::max(1.0, 2.0 * static_cast<double>(m) - 3.0)) *
       H.ldlt().solve(Eigen::Matrix3d::Identity());
   const int index[3] = {0, 1, 5};  // east, north, yaw in the 6-DoF parameter order
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) fit.covariance(index[r], index[c]) = horizontal_covariance(r, c);
-  fit.covariance(2, 2) = chi2_up / std::max(1.0, static_cast<double>(m) - 1.0) / denominator;
+  fit.covariance(2, 2) =
+      std::max(1.0, chi2_up / std::max(1.0, static_cast<double>(m) - 1.0)) / denominator;
   fit.covariance(3, 3) = fit.covariance(4, 4) =
       options.gravity_tilt_sigma_rad * options.gravity_tilt_sigma_rad;
-  detail::finishFit(pairs, fit);
+  detail::finishFit(pairs, options, fit);
   return fit;
 }
 

@@ -42,6 +42,9 @@ void expectErrorsWithinSigmas(const Errors& e, const GeorefFit& fit, double k) {
   }
 }
 
+/// The synthetic noise is white: no inflation for correlated errors.
+const FitOptions kWhite{.error_correlation_time_s = 0.0};
+
 const lie::SE3 kTiltedTruth(lie::SO3::fromRollPitchYaw(deg(0.8), deg(-0.5), deg(37.0)),
                             Eigen::Vector3d(312.5, -457.25, 23.1));
 const lie::SE3 kLevelTruth(lie::SO3::fromRollPitchYaw(0.0, 0.0, deg(37.0)),
@@ -56,7 +59,7 @@ TEST(GeorefFit, MethodNamesRoundTripAndUnknownNamesAreInputErrors) {
 
 TEST(GeorefFit, ClosedRecoversATiltedTransformFromNoisyFixes) {
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kTiltedTruth, {});
-  const GeorefFit fit = fitClosed(fixes.pairs, {});
+  const GeorefFit fit = fitClosed(fixes.pairs, kWhite);
   const Errors e = errorsOf(fit, kTiltedTruth);
   EXPECT_LT(e.translation_m.head<2>().norm(), 0.2);
   EXPECT_LT(std::abs(e.translation_m.z()), 0.35);
@@ -71,7 +74,7 @@ TEST(GeorefFit, ClosedRecoversATiltedTransformFromNoisyFixes) {
 
 TEST(GeorefFit, Pf3WeighsTheBetterHorizontalFixesAndRecoversTheTransform) {
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kTiltedTruth, {});
-  const GeorefFit pf3 = fitPf3(fixes.pairs, {});
+  const GeorefFit pf3 = fitPf3(fixes.pairs, kWhite);
   EXPECT_TRUE(pf3.converged);
   const Errors e = errorsOf(pf3, kTiltedTruth);
   EXPECT_LT(e.translation_m.head<2>().norm(), 0.2);
@@ -79,7 +82,7 @@ TEST(GeorefFit, Pf3WeighsTheBetterHorizontalFixesAndRecoversTheTransform) {
   expectErrorsWithinSigmas(e, pf3, 4.0);
   // Weighting trusts the horizontal twice as much as the vertical: pf3's reported roll/pitch
   // sigma is below the unweighted closed fit's (whose variance factor mixes in the bad heights).
-  const GeorefFit closed = fitClosed(fixes.pairs, {});
+  const GeorefFit closed = fitClosed(fixes.pairs, kWhite);
   EXPECT_LT(pf3.sigma[5], closed.sigma[5]);
 }
 
@@ -92,8 +95,8 @@ TEST(GeorefFit, Pf3FollowsTheCovarianceOfEachFix) {
     fixes.pairs[i].fix.p_enu += Eigen::Vector3d(gauss(random), gauss(random), 2.0 * gauss(random));
     fixes.pairs[i].fix.covariance_enu_m2 = Eigen::Vector3d(25.25, 25.25, 101.0).asDiagonal();
   }
-  const Errors pf3 = errorsOf(fitPf3(fixes.pairs, {}), kLevelTruth);
-  const Errors closed = errorsOf(fitClosed(fixes.pairs, {}), kLevelTruth);
+  const Errors pf3 = errorsOf(fitPf3(fixes.pairs, kWhite), kLevelTruth);
+  const Errors closed = errorsOf(fitClosed(fixes.pairs, kWhite), kLevelTruth);
   EXPECT_LT(pf3.translation_m.head<2>().norm(), 0.25);
   EXPECT_LT(pf3.translation_m.norm(), closed.translation_m.norm());
   EXPECT_LT(pf3.rotation_rad.norm(), closed.rotation_rad.norm());
@@ -116,7 +119,7 @@ std::vector<std::optional<lie::SO3>> measuredOrientations(const test::SyntheticF
 
 TEST(GeorefFit, Pf6UsesTheImuOrientationForRollAndPitch) {
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kTiltedTruth, {});
-  FitOptions options;
+  FitOptions options = kWhite;
   options.orientation_tilt_sigma_rad = deg(0.5);
   options.orientation_heading_sigma_rad = deg(2.0);
   const auto orientations = measuredOrientations(fixes, kTiltedTruth, deg(0.5), deg(2.0));
@@ -130,7 +133,7 @@ TEST(GeorefFit, Pf6UsesTheImuOrientationForRollAndPitch) {
   EXPECT_LT(e.rotation_rad.head<2>().norm(), deg(0.15));
   EXPECT_LT(std::abs(e.rotation_rad.z()), deg(0.25));
   expectErrorsWithinSigmas(e, pf6, 4.0);
-  const GeorefFit closed = fitClosed(fixes.pairs, {});
+  const GeorefFit closed = fitClosed(fixes.pairs, kWhite);
   EXPECT_GT(closed.sigma[3], 2.5 * pf6.sigma[3]);
   EXPECT_GT(closed.sigma[4], 2.5 * pf6.sigma[4]);
 }
@@ -139,7 +142,7 @@ TEST(GeorefFit, Pf6WithoutOrientationIsAnErrorNotASilentFallback) {
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kTiltedTruth, {});
   const std::vector<std::optional<lie::SO3>> none(fixes.pairs.size());
   try {
-    fitPf6(fixes.pairs, none, {});
+    fitPf6(fixes.pairs, none, kWhite);
     FAIL() << "pf6 without orientation did not throw";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("0 of 300 associated fixes have an absolute IMU orientation"));
@@ -150,7 +153,7 @@ TEST(GeorefFit, Pf6SkipsFixesWithoutOrientationAndCountsThem) {
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kTiltedTruth, {});
   auto orientations = measuredOrientations(fixes, kTiltedTruth, deg(0.5), deg(2.0));
   for (std::size_t i = 0; i < orientations.size(); i += 3) orientations[i].reset();
-  const GeorefFit pf6 = fitPf6(fixes.pairs, orientations, {});
+  const GeorefFit pf6 = fitPf6(fixes.pairs, orientations, kWhite);
   EXPECT_EQ(pf6.without_orientation, (orientations.size() + 2) / 3);
   EXPECT_EQ(pf6.inliers, orientations.size() - pf6.without_orientation);
   EXPECT_LT(errorsOf(pf6, kTiltedTruth).translation_m.head<2>().norm(), 0.25);
@@ -158,7 +161,7 @@ TEST(GeorefFit, Pf6SkipsFixesWithoutOrientationAndCountsThem) {
 
 TEST(GeorefFit, RobustRecoversYawOffsetAndHeightOfALevelMap) {
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kLevelTruth, {});
-  const GeorefFit fit = fitRobust(fixes.pairs, {});
+  const GeorefFit fit = fitRobust(fixes.pairs, kWhite);
   EXPECT_TRUE(fit.converged);
   const Errors e = errorsOf(fit, kLevelTruth);
   EXPECT_LT(e.translation_m.head<2>().norm(), 0.2);
@@ -182,13 +185,13 @@ TEST(GeorefFit, MultipathBreaksTheClosedFitButNotTheRobustOne) {
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kLevelTruth, noise);
   ASSERT_GT(fixes.multipath, 20u);
 
-  const Errors closed = errorsOf(fitClosed(fixes.pairs, {}), kLevelTruth);
-  const Errors pf3 = errorsOf(fitPf3(fixes.pairs, {}), kLevelTruth);
+  const Errors closed = errorsOf(fitClosed(fixes.pairs, kWhite), kLevelTruth);
+  const Errors pf3 = errorsOf(fitPf3(fixes.pairs, kWhite), kLevelTruth);
   // Both least-squares fits are pulled by the mean jump, several metres times the share.
   EXPECT_GT(closed.translation_m.head<2>().norm(), 1.0);
   EXPECT_GT(pf3.translation_m.head<2>().norm(), 1.0);
 
-  const GeorefFit robust = fitRobust(fixes.pairs, {});
+  const GeorefFit robust = fitRobust(fixes.pairs, kWhite);
   const Errors e = errorsOf(robust, kLevelTruth);
   EXPECT_LT(e.translation_m.head<2>().norm(), 0.2);
   EXPECT_LT(std::abs(e.translation_m.z()), 0.35);
@@ -205,8 +208,8 @@ TEST(GeorefFit, MultipathBreaksTheClosedFitButNotTheRobustOne) {
 TEST(GeorefFit, TooFewFixesOrAStraightLineAreInputErrors) {
   auto fixes = test::synthesizeFixes(test::loopWalk(), kLevelTruth, {});
   std::vector<AssociatedFix> two(fixes.pairs.begin(), fixes.pairs.begin() + 2);
-  EXPECT_THROW(fitRobust(two, {}), InputError);
-  EXPECT_THROW(fitClosed(two, {}), InputError);
+  EXPECT_THROW(fitRobust(two, kWhite), InputError);
+  EXPECT_THROW(fitClosed(two, kWhite), InputError);
   // A straight level walk: heading is determined horizontally (robust), roll about the line is
   // not (closed, pf3).
   std::vector<AssociatedFix> line;
@@ -217,9 +220,9 @@ TEST(GeorefFit, TooFewFixesOrAStraightLineAreInputErrors) {
     pair.fix.p_enu = kLevelTruth * pair.p_world;
     line.push_back(pair);
   }
-  EXPECT_THROW(fitClosed(line, {}), InputError);
-  EXPECT_THROW(fitPf3(line, {}), InputError);
-  const GeorefFit robust = fitRobust(line, {});
+  EXPECT_THROW(fitClosed(line, kWhite), InputError);
+  EXPECT_THROW(fitPf3(line, kWhite), InputError);
+  const GeorefFit robust = fitRobust(line, kWhite);
   EXPECT_LT(std::abs(errorsOf(robust, kLevelTruth).rotation_rad.z()), 1e-9);
 }
 
@@ -228,9 +231,42 @@ TEST(GeorefFit, SameInputGivesIdenticalOutput) {
   noise.multipath_share = 0.04;
   const auto fixes = test::synthesizeFixes(test::loopWalk(), kLevelTruth, noise);
   for (auto method : {fitClosed, fitPf3, fitRobust}) {
-    const GeorefFit a = method(fixes.pairs, {}), b = method(fixes.pairs, {});
+    const GeorefFit a = method(fixes.pairs, kWhite), b = method(fixes.pairs, kWhite);
     EXPECT_EQ(a.T_enu_world.matrix(), b.T_enu_world.matrix());
     EXPECT_EQ(a.sigma, b.sigma);
+  }
+}
+
+TEST(GeorefFit, CorrelatedErrorsInflateTheReportedSigmasToMatchTheActualSpread) {
+  // Gauss-Markov GNSS errors (tau 30 s) over 40 independent walks: the spread of the robust
+  // fit's errors is several times the white-noise sigma, and the inflated sigma follows it.
+  constexpr int kRuns = 40;
+  const Trajectory walk = test::loopWalk();
+  Eigen::Vector3d sum_squares = Eigen::Vector3d::Zero(), sum_sigma2_white = Eigen::Vector3d::Zero(),
+                  sum_sigma2 = Eigen::Vector3d::Zero();
+  for (int run = 0; run < kRuns; ++run) {
+    test::NoiseModel noise;
+    noise.correlation_time_s = 30.0;
+    noise.seed = 100 + run;
+    const auto fixes = test::synthesizeFixes(walk, kLevelTruth, noise);
+    const GeorefFit white = fitRobust(fixes.pairs, kWhite);
+    const GeorefFit correlated = fitRobust(fixes.pairs, FitOptions{.error_correlation_time_s = 30.0});
+    EXPECT_EQ(white.T_enu_world.matrix(), correlated.T_enu_world.matrix());
+    const Errors e = errorsOf(correlated, kLevelTruth);
+    const Eigen::Vector3d error(e.translation_m.x(), e.translation_m.y(), e.rotation_rad.z());
+    sum_squares += error.cwiseProduct(error);
+    const Eigen::Vector3d sigma_white(white.sigma[0], white.sigma[1], white.sigma[5]);
+    const Eigen::Vector3d sigma(correlated.sigma[0], correlated.sigma[1], correlated.sigma[5]);
+    sum_sigma2_white += sigma_white.cwiseProduct(sigma_white);
+    sum_sigma2 += sigma.cwiseProduct(sigma);
+  }
+  const Eigen::Vector3d actual = (sum_squares / kRuns).cwiseSqrt();
+  const Eigen::Vector3d reported = (sum_sigma2 / kRuns).cwiseSqrt();
+  const Eigen::Vector3d reported_white = (sum_sigma2_white / kRuns).cwiseSqrt();
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GT(actual[k], 2.0 * reported_white[k]) << k;  // white sigmas are far too optimistic
+    EXPECT_GT(reported[k], 0.5 * actual[k]) << k;
+    EXPECT_LT(reported[k], 2.0 * actual[k]) << k;
   }
 }
 

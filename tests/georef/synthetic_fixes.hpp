@@ -36,6 +36,8 @@ inline Trajectory loopWalk(double duration_s = 300.0) {
 struct NoiseModel {
   double sigma_horizontal_m = 0.5;
   double sigma_vertical_m = 1.0;
+  /// 0: white noise; > 0: first-order Gauss-Markov errors with this correlation time, s.
+  double correlation_time_s = 0.0;
   /// Share of fixes that start a multipath burst of `burst_fixes` fixes offset by `jump_m`.
   double multipath_share = 0.0;
   int burst_fixes = 3;
@@ -57,14 +59,24 @@ inline SyntheticFixes synthesizeFixes(const Trajectory& trajectory, const lie::S
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   SyntheticFixes out;
   int burst_left = 0;
+  Eigen::Vector3d markov = Eigen::Vector3d::Zero();  // unit-variance Gauss-Markov state
+  bool first = true;
   for (double t = trajectory.startTime() + 0.5; t < trajectory.endTime(); t += 1.0) {
     AssociatedFix pair;
     pair.T_world_body = trajectory.poseAt(t);
     pair.p_world = pair.T_world_body.translation();
     pair.fix.t_s = t;
-    const Eigen::Vector3d error(noise.sigma_horizontal_m * gauss(random),
-                                noise.sigma_horizontal_m * gauss(random),
-                                noise.sigma_vertical_m * gauss(random));
+    const Eigen::Vector3d white(gauss(random), gauss(random), gauss(random));
+    if (noise.correlation_time_s > 0.0 && !first) {
+      const double rho = std::exp(-1.0 / noise.correlation_time_s);  // fixes 1 s apart
+      markov = rho * markov + std::sqrt(1.0 - rho * rho) * white;
+    } else {
+      markov = white;
+    }
+    first = false;
+    const Eigen::Vector3d error(noise.sigma_horizontal_m * markov.x(),
+                                noise.sigma_horizontal_m * markov.y(),
+                                noise.sigma_vertical_m * markov.z());
     pair.fix.p_enu = T_enu_world * pair.p_world + error;
     pair.fix.covariance_enu_m2 =
         Eigen::Vector3d(noise.sigma_horizontal_m * noise.sigma_horizontal_m,

@@ -1,0 +1,286 @@
+// `taiga georef` as users run it: on short simulated recordings against the simulator's
+// georef_truth.yaml (exact without GNSS noise, within the noise's reach with canopy-degraded
+// GNSS), on a fixes CSV, and with bad input that must give a clear error naming the file.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../support/run_taiga.hpp"
+#include "../support/temp_dir.hpp"
+#include "taiga/geo/coordinates.hpp"
+#include "taiga/io/trajectory_io.hpp"
+
+namespace taiga {
+namespace {
+
+using ::testing::HasSubstr;
+using test::runTaiga;
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+std::string readText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+Eigen::Matrix4d matrixOf(const YAML::Node& rows) {
+  Eigen::Matrix4d M;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) M(r, c) = rows[r][c].as<double>();
+  return M;
+}
+
+/// Errors of `taiga georef`'s exact grid trajectory against the truth T_epsg_world (whose
+/// tangent-plane error is below 0.2 mm within 50 m of the origin) and of its heading.
+struct GeorefErrors {
+  double max_horizontal_m = 0.0;
+  double mean_height_m = 0.0;
+  double max_height_m = 0.0;
+  double heading_deg = 0.0;      ///< yaw_grid_world in georef.yaml minus the truth's
+  double max_yaw_column_deg = 0.0;  ///< yaw_grid_deg column against the true body heading
+};
+
+GeorefErrors scoreAgainstTruth(const std::filesystem::path& sim_dir,
+                               const std::filesystem::path& out_dir) {
+  const YAML::Node truth = YAML::LoadFile((sim_dir / "georef_truth.yaml").string());
+  const YAML::Node fit = YAML::LoadFile((out_dir / "georef.yaml").string());
+  const Eigen::Matrix4d T_epsg_world = matrixOf(truth["T_epsg_world"]);
+  const Trajectory groundtruth = io::readTum(sim_dir / "groundtruth.tum");
+  std::ifstream csv(out_dir / "trajectory_epsg3067.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "t_s,easting_m,northing_m,height_m,yaw_grid_deg");
+  GeorefErrors errors;
+  std::size_t rows = 0;
+  for (const StampedPose& pose : groundtruth) {
+    EXPECT_TRUE(std::getline(csv, line));
+    std::vector<double> values;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) values.push_back(std::stod(cell));
+    EXPECT_EQ(values.size(), 5u);
+    EXPECT_EQ(values[0], pose.t_s);
+    const Eigen::Vector3d truth_grid = (T_epsg_world * pose.pose.translation().homogeneous()).head<3>();
+    errors.max_horizontal_m = std::max(
+        errors.max_horizontal_m, std::hypot(values[1] - truth_grid.x(), values[2] - truth_grid.y()));
+    errors.mean_height_m += values[3] - truth_grid.z();
+    errors.max_height_m = std::max(errors.max_height_m, std::abs(values[3] - truth_grid.z()));
+    const Eigen::Vector3d x_world = pose.pose.rotation().matrix().col(0);
+    const double truth_yaw_deg =
+        std::atan2(x_world.y(), x_world.x()) * kDeg + truth["yaw_grid_world_deg"].as<double>();
+    errors.max_yaw_column_deg = std::max(
+        errors.max_yaw_column_deg, std::abs(std::remainder(values[4] - truth_yaw_deg, 360.0)));
+    ++rows;
+  }
+  EXPECT_EQ(rows, groundtruth.size());
+  errors.mean_height_m /= static_cast<double>(std::max<std::size_t>(rows, 1));
+  errors.heading_deg = std::remainder(
+      fit["yaw_grid_world_deg"].as<double>() - truth["yaw_grid_world_deg"].as<double>(), 360.0);
+  return errors;
+}
+
+/// A 30 s handheld-loop recording with a small lidar head (the scans are not used here).
+std::filesystem::path simulate(const test::TempDir& dir, const std::string& name,
+                               const std::string& overrides, int seed) {
+  const auto overrides_file = dir.write(name + ".yaml", overrides);
+  const test::TaigaResult sim = runTaiga(
+      "simulate --scenario handheld-loop --duration 30 --beams 16 --columns 512 --sub-rays 1 --seed " +
+      std::to_string(seed) + " --overrides " + overrides_file.string() + " --out " +
+      dir.file(name).string());
+  EXPECT_EQ(sim.exit_code, 0) << sim.output;
+  return dir.file(name);
+}
+
+TEST(GeorefCli, EveryMethodRecoversTheExactGeoreferenceFromNoiseFreeGnss) {
+  test::TempDir dir;
+  // A world frame turned 30 deg from east, exact fixes, an exact IMU orientation (for pf6).
+  const auto sim = simulate(dir, "exact",
+                            "gnss: {noise: false, world_yaw_deg: 30}\n"
+                            "imu: {noise: false, orientation_heading_offset_deg: 0}\n",
+                            3);
+  for (const std::string method : {"closed", "pf3", "pf6", "robust"}) {
+    const auto out = dir.file("out_" + method);
+    const test::TaigaResult r =
+        runTaiga("georef --traj " + (sim / "groundtruth.tum").string() + " --gnss " +
+                 (sim / "recording.bag").string() + " --method " + method + " --out " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("georef " + method + ": "));
+    const GeorefErrors e = scoreAgainstTruth(sim, out);
+    EXPECT_LT(e.max_horizontal_m, 0.005) << method;
+    EXPECT_LT(e.max_height_m, 0.005) << method;
+    EXPECT_LT(std::abs(e.heading_deg), 0.001) << method;
+    EXPECT_LT(e.max_yaw_column_deg, 0.001) << method;
+  }
+}
+
+TEST(GeorefCli, RobustMethodOnCanopyDegradedGnssStaysWithinTheNoiseAndItsReportedSigma) {
+  test::TempDir dir;
+  const auto sim = simulate(dir, "canopy", "gnss: {world_yaw_deg: -40}\n", 4);
+  const auto out = dir.file("out");
+  const test::TaigaResult r =
+      runTaiga("georef --traj " + (sim / "groundtruth.tum").string() + " --gnss " +
+               (sim / "recording.bag").string() + " --out " + out.string());  // robust: default
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const GeorefErrors e = scoreAgainstTruth(sim, out);
+  const YAML::Node fit = YAML::LoadFile((out / "georef.yaml").string());
+  ::testing::Test::RecordProperty("horizontal_error_m", std::to_string(e.max_horizontal_m));
+  ::testing::Test::RecordProperty("heading_error_deg", std::to_string(e.heading_deg));
+  ::testing::Test::RecordProperty("height_error_m", std::to_string(e.mean_height_m));
+  // The simulated error is 0.4 m + 2.5 m x canopy cover horizontally (1-sigma; 1.8x vertically),
+  // correlated over 30 s: over a 30 s walk the fixes' mean error is about one sigma, so the
+  // fit is off by a few metres at most, its heading by a few degrees over a 40 m path.
+  EXPECT_LT(e.max_horizontal_m, 5.0);
+  EXPECT_LT(std::abs(e.mean_height_m), 6.0);
+  EXPECT_LT(std::abs(e.heading_deg), 10.0);
+  // The reported sigmas (inflated for the error correlation) cover the errors.
+  const double sigma_horizontal = std::hypot(fit["sigma"]["east_m"].as<double>(),
+                                             fit["sigma"]["north_m"].as<double>());
+  EXPECT_LT(e.max_horizontal_m, 3.0 * sigma_horizontal);
+  EXPECT_LT(std::abs(e.mean_height_m), 3.0 * fit["sigma"]["up_m"].as<double>());
+  EXPECT_LT(std::abs(e.heading_deg), 3.0 * fit["sigma"]["yaw_deg"].as<double>());
+  EXPECT_EQ(fit["method"].as<std::string>(), "robust");
+  EXPECT_EQ(fit["epsg"].as<int>(), 3067);
+  EXPECT_GE(fit["fixes"]["used"].as<int>(), 20);
+  EXPECT_EQ(fit["T_enu_world_roll_pitch_yaw_deg"][0].as<double>(), 0.0);
+
+  // GeoJSON for QGIS: a LineString in the named CRS with one vertex per pose.
+  const nlohmann::json geojson = nlohmann::json::parse(readText(out / "trajectory.geojson"));
+  EXPECT_EQ(geojson["crs"]["properties"]["name"], "urn:ogc:def:crs:EPSG::3067");
+  EXPECT_EQ(geojson["features"][0]["geometry"]["type"], "LineString");
+  EXPECT_EQ(geojson["features"][0]["geometry"]["coordinates"].size(),
+            io::readTum(sim / "groundtruth.tum").size());
+
+  // Same input, same bytes.
+  const auto again = dir.file("again");
+  ASSERT_EQ(runTaiga("georef --traj " + (sim / "groundtruth.tum").string() + " --gnss " +
+                     (sim / "recording.bag").string() + " --out " + again.string())
+                .exit_code,
+            0);
+  for (const char* file : {"georef.yaml", "trajectory_epsg3067.csv", "trajectory.geojson"})
+    EXPECT_EQ(readText(out / file), readText(again / file)) << file;
+}
+
+TEST(GeorefCli, Pf6OnARecordingWithoutImuOrientationSaysSo) {
+  test::TempDir dir;
+  const auto sim = simulate(dir, "six_axis", "imu: {orientation_output: false}\n", 2);
+  const test::TaigaResult r =
+      runTaiga("georef --traj " + (sim / "groundtruth.tum").string() + " --gnss " +
+               (sim / "recording.bag").string() + " --method pf6 --out " + dir.file("out").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("recording.bag: georef pf6: 0 of"));
+  EXPECT_THAT(r.output, HasSubstr("have an absolute IMU orientation"));
+}
+
+/// A 60 s circle of radius 20 m in the world frame (TUM) and fixes of it in a CSV, with
+/// T_enu_world = (yaw 37 deg, (250, -120, 3)) at an ENU origin in southern Finland.
+struct CsvCase {
+  std::filesystem::path trajectory, fixes;
+  geo::Geodetic origin{60.5, 25.0, 80.0};
+  lie::SE3 T_enu_world{lie::SO3::fromRollPitchYaw(0.0, 0.0, 37.0 / kDeg),
+                       Eigen::Vector3d(250.0, -120.0, 3.0)};
+};
+
+CsvCase writeCsvCase(const test::TempDir& dir, const std::string& fixes_name = "fixes.csv",
+                     double time_shift_s = 0.0, double sigma_m = 0.3) {
+  const geo::CoordinateConverter converter(3067);
+  CsvCase result;
+  const geo::Geodetic& origin = result.origin;
+  const lie::SE3& T_enu_world = result.T_enu_world;
+  Trajectory trajectory;
+  std::string csv = "# test fixes\nt_s,latitude_deg,longitude_deg,height_m,sigma_east_m,sigma_north_m,sigma_up_m\n";
+  for (int k = 0; k <= 600; ++k) {
+    const double t = 100.0 + 0.1 * k, angle = 2.0 * std::numbers::pi * k / 600.0;
+    const Eigen::Vector3d p_world(20.0 * std::cos(angle), 20.0 * std::sin(angle), 0.5 * std::sin(3.0 * angle));
+    trajectory.append(t, lie::SE3(lie::SO3::fromRollPitchYaw(0.0, 0.0, angle + 1.5), p_world));
+    if (k % 10 == 5) {
+      const geo::Geodetic fix = converter.fromEnu(origin, T_enu_world * p_world);
+      csv += fmt::format("{},{},{},{},{},{},{}\n", t + time_shift_s, fix.latitude_deg,
+                         fix.longitude_deg, fix.height_m, sigma_m, sigma_m, 2.0 * sigma_m);
+    }
+  }
+  io::writeTum(dir.file("circle.tum"), trajectory);
+  result.trajectory = dir.file("circle.tum");
+  result.fixes = dir.write(fixes_name, csv);
+  return result;
+}
+
+TEST(GeorefCli, FixesFromACsvFile) {
+  test::TempDir dir;
+  const CsvCase input = writeCsvCase(dir);
+  const test::TaigaResult r = runTaiga("georef --traj " + input.trajectory.string() + " --gnss " +
+                                       input.fixes.string() + " --method pf3 --epsg 32635 --out " +
+                                       dir.file("out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("out/trajectory_epsg32635.csv")));
+  const YAML::Node fit = YAML::LoadFile(dir.file("out/georef.yaml").string());
+  EXPECT_EQ(fit["epsg"].as<int>(), 32635);
+  EXPECT_NEAR(fit["residual_rms_m"]["total"].as<double>(), 0.0, 1e-6);
+  EXPECT_EQ(fit["fixes"]["used"].as<int>(), 60);
+  // Noise-free fixes: every pose lands on its exact UTM 35N coordinates. (The fit's ENU frame
+  // is at the first fix, turned against the one the fixes were made in by the meridians'
+  // convergence, 0.004 deg over 250 m here, so T_enu_world itself differs from the generating
+  // one; the grid coordinates do not.)
+  const geo::CoordinateConverter utm35n(32635);
+  const Trajectory trajectory = io::readTum(input.trajectory);
+  std::ifstream csv(dir.file("out/trajectory_epsg32635.csv"));
+  std::string line;
+  std::getline(csv, line);
+  double max_error_m = 0.0;
+  for (const StampedPose& pose : trajectory) {
+    ASSERT_TRUE(std::getline(csv, line));
+    double t, easting, northing, height, yaw;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf", &t, &easting, &northing, &height, &yaw), 5);
+    const Eigen::Vector3d expected = utm35n.toProjected(
+        utm35n.fromEnu(input.origin, input.T_enu_world * pose.pose.translation()));
+    max_error_m = std::max(max_error_m, (Eigen::Vector3d(easting, northing, height) - expected).norm());
+  }
+  EXPECT_LT(max_error_m, 1e-4);
+}
+
+TEST(GeorefCli, BadInputGivesAnErrorNamingTheFileAndField) {
+  test::TempDir dir;
+  const CsvCase input = writeCsvCase(dir);
+  const std::string traj = " --traj " + input.trajectory.string();
+  const std::string out = " --out " + dir.file("out").string();
+  const auto expectError = [&](const std::string& arguments, const std::string& message) {
+    const test::TaigaResult r = runTaiga("georef" + arguments);
+    EXPECT_EQ(r.exit_code, 2) << arguments << "\n" << r.output;
+    EXPECT_THAT(r.output, HasSubstr(message)) << arguments;
+  };
+  expectError(traj + " --gnss " + input.fixes.string() + " --epsg 4326" + out,
+              "EPSG:4326: 'WGS 84' is not a projected CRS");
+  expectError(traj + " --gnss " + input.fixes.string() + " --epsg 999999" + out, "999999");
+  const auto empty = dir.write("empty.csv", "t_s,latitude_deg,longitude_deg,height_m\n");
+  expectError(traj + " --gnss " + empty.string() + out, "empty.csv: no GNSS fixes");
+  expectError(traj + " --gnss " + input.fixes.string() + " --max-horizontal-sigma 0.1" + out,
+              "fixes.csv: all 60 GNSS fixes were gated: 0 without a fix (status -1), 60 with a "
+              "reported horizontal sigma above --max-horizontal-sigma 0.1 m");
+  const CsvCase late = writeCsvCase(dir, "late.csv", 1000.0);
+  expectError(traj + " --gnss " + late.fixes.string() + out,
+              "overlap at only 0 fix(es), at least 3 are needed (60 outside the trajectory's time span");
+  const auto bad_number = dir.write(
+      "bad.csv", "t_s,latitude_deg,longitude_deg,height_m\n1,60.1,25.0,80\n2,60.1,east,80\n");
+  expectError(traj + " --gnss " + bad_number.string() + out,
+              "bad.csv:3: column 'longitude_deg': expected a finite number, got 'east'");
+  const auto no_column = dir.write("nocol.csv", "t_s,lat,lon,h\n1,60.1,25.0,80\n");
+  expectError(traj + " --gnss " + no_column.string() + out,
+              "nocol.csv:1: the header has no column 'latitude_deg'");
+  expectError(traj + " --gnss " + dir.file("missing.csv").string() + out,
+              "missing.csv: cannot open the GNSS fixes file");
+  expectError(traj + " --gnss " + input.fixes.string() + " --method pf6" + out,
+              "--method pf6 needs the IMU's absolute orientation, which a fixes CSV does not carry");
+}
+
+}  // namespace
+}  // namespace taiga
