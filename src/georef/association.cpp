@@ -15,14 +15,15 @@ Association associateFixes(const Trajectory& trajectory_world_body,
       ++association.outside_span;
       continue;
     }
-    // The first pose later than the fix; the fix lies in [before, after].
+    // The first pose later than the fix; the fix lies in [before, after).
     auto after = std::upper_bound(poses.begin(), poses.end(), fix.t_s,
                                   [](double t, const StampedPose& pose) { return t < pose.t_s; });
+    // covers() puts the fix at or after the first pose, so `after` is not the first pose.
+    const StampedPose& before = *(after - 1);
     lie::SE3 T_world_body;
-    if (after == poses.end()) {
-      T_world_body = poses.back().pose;  // exactly at the last pose
+    if (before.t_s == fix.t_s) {
+      T_world_body = before.pose;  // exactly at a pose: no gap to check
     } else {
-      const StampedPose& before = *(after - 1);
       if (after->t_s - before.t_s > options.max_gap_s) {
         ++association.in_gap;
         continue;
