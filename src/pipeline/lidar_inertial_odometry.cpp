@@ -50,7 +50,8 @@ LidarInertialOdometry::LidarInertialOdometry(const OdometryConfig& config, const
       rig_(rig),
       gravity_world_(0.0, 0.0, -config.imu.gravity_mps2),
       smoother_({.gravity_world = gravity_world_, .window_states = config.window_states}),
-      local_map_(config.ndt_resolution_m, config.local_map_voxel_m, config.local_map_keyframes),
+      local_map_(config.ndt_resolution_m, config.local_map_voxel_m, config.local_map_keyframes,
+                 config.method == "gicp" ? LocalMap::Target::kGicp : LocalMap::Target::kNdt),
       levelled_(config.gravity_alignment_s <= 0.0) {
   const lie::SE3 T_lidar_body = rig_.T_body_lidar.inverse();
   for (const Box& box : rig_.self_boxes_body)
@@ -331,6 +332,7 @@ registration::RegistrationResult LidarInertialOdometry::registerToMap(
   ndt.resolution_m = config_.ndt_resolution_m;
   ndt.search = config_.ndt_neighbours == "direct1" ? registration::NeighbourSearch::kDirect1
                                                    : registration::NeighbourSearch::kDirect7;
+  local_map_.beginRegistration();
   registration::RegistrationResult result;
   if (config_.method == "gicp") {
     result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),
@@ -440,8 +442,7 @@ void LidarInertialOdometry::levelWorld(ScanOutcome& outcome) {
   smoother_.initialize(levelled);
   // The keyframes so far were deskewed with the velocity still unknown (zero at the start): the
   // local map starts over from this scan, deskewed with the velocity the odometry has found.
-  local_map_ =
-      LocalMap(config_.ndt_resolution_m, config_.local_map_voxel_m, config_.local_map_keyframes);
+  local_map_.clear();
   last_keyframe_T_world_body_.reset();
   outcome.T_world_body = poseOf(levelled.state);
   outcome.v_world = levelled.state.v_world;

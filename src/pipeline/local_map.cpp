@@ -1,15 +1,39 @@
 #include "taiga/pipeline/local_map.hpp"
 
+#include <stdexcept>
+
 namespace taiga::pipeline {
 
 LocalMap::LocalMap(double ndt_resolution_m, double point_spacing_m, int max_keyframes,
-                   const registration::GicpConfig& gicp)
+                   Target target, const registration::GicpConfig& gicp)
     : max_keyframes_(max_keyframes),
+      target_(target),
       gicp_config_(gicp),
       statistics_(ndt_resolution_m),
       point_statistics_(point_spacing_m) {}
 
+LocalMap::~LocalMap() {
+  if (pending_.valid()) pending_.wait();
+}
+
+LocalMap::SearchStructures LocalMap::build() const {
+  SearchStructures built;
+  const std::vector<Eigen::Vector3d> points = point_statistics_.means();
+  if (target_ == Target::kNdt) {
+    built.ndt_target = std::make_unique<registration::NdtTarget>(statistics_);
+  } else {
+    built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
+  }
+  built.kd_tree = std::make_unique<registration::KdTree>(points);
+  return built;
+}
+
+void LocalMap::finishPendingBuild() {
+  if (pending_.valid()) in_use_ = pending_.get();
+}
+
 void LocalMap::addKeyframe(std::vector<Eigen::Vector3d> points_in_world) {
+  finishPendingBuild();  // it reads the statistics that change now
   statistics_.add(points_in_world);
   point_statistics_.add(points_in_world);
   keyframes_.push_back(std::move(points_in_world));
@@ -18,22 +42,23 @@ void LocalMap::addKeyframe(std::vector<Eigen::Vector3d> points_in_world) {
     point_statistics_.remove(keyframes_.front());
     keyframes_.pop_front();
   }
-  ndt_target_.reset();
-  kd_tree_.reset();
-  gicp_cloud_.reset();
+  pending_ = std::async(std::launch::async, [this] { return build(); });
+  registrations_since_keyframe_ = 0;
 }
 
-void LocalMap::transform(const lie::SE3& T_new_old) {
+void LocalMap::beginRegistration() {
+  if (!pending_.valid()) return;
+  const bool have_previous = in_use_.kd_tree != nullptr;
+  if (have_previous && registrations_since_keyframe_++ < kScansOnPreviousMap) return;
+  finishPendingBuild();
+}
+
+void LocalMap::clear() {
+  finishPendingBuild();
   statistics_.clear();
   point_statistics_.clear();
-  for (auto& keyframe : keyframes_) {
-    for (Eigen::Vector3d& p : keyframe) p = T_new_old * p;
-    statistics_.add(keyframe);
-    point_statistics_.add(keyframe);
-  }
-  ndt_target_.reset();
-  kd_tree_.reset();
-  gicp_cloud_.reset();
+  keyframes_.clear();
+  in_use_ = {};
 }
 
 std::size_t LocalMap::numPoints() const {
@@ -42,21 +67,20 @@ std::size_t LocalMap::numPoints() const {
   return n;
 }
 
-const registration::NdtTarget& LocalMap::ndtTarget() {
-  if (!ndt_target_) ndt_target_ = std::make_unique<registration::NdtTarget>(statistics_);
-  return *ndt_target_;
+namespace {
+template <typename T>
+const T& inUse(const std::unique_ptr<T>& structure, const char* what) {
+  if (!structure) throw std::logic_error(std::string("LocalMap: no ") + what + " in use");
+  return *structure;
 }
+}  // namespace
 
-const registration::KdTree& LocalMap::kdTree() {
-  if (!kd_tree_) kd_tree_ = std::make_unique<registration::KdTree>(point_statistics_.means());
-  return *kd_tree_;
+const registration::NdtTarget& LocalMap::ndtTarget() const {
+  return inUse(in_use_.ndt_target, "NDT target");
 }
-
-const registration::GicpCloud& LocalMap::gicpCloud() {
-  if (!gicp_cloud_)
-    gicp_cloud_ =
-        std::make_unique<registration::GicpCloud>(point_statistics_.means(), gicp_config_);
-  return *gicp_cloud_;
+const registration::KdTree& LocalMap::kdTree() const { return inUse(in_use_.kd_tree, "kd-tree"); }
+const registration::GicpCloud& LocalMap::gicpCloud() const {
+  return inUse(in_use_.gicp_cloud, "GICP cloud");
 }
 
 }  // namespace taiga::pipeline
