@@ -265,7 +265,7 @@ TEST(GeorefCli, BadInputGivesAnErrorNamingTheFileAndField) {
   expectError(traj + " --gnss " + empty.string() + out, "empty.csv: no GNSS fixes");
   expectError(traj + " --gnss " + input.fixes.string() + " --max-horizontal-sigma 0.1" + out,
               "fixes.csv: all 60 GNSS fixes were gated: 0 without a fix (status -1), 60 with a "
-              "reported horizontal sigma above --max-horizontal-sigma 0.1 m");
+              "reported horizontal sigma above georef.max_horizontal_sigma_m (--max-horizontal-sigma) 0.1 m");
   const CsvCase late = writeCsvCase(dir, "late.csv", 1000.0);
   expectError(traj + " --gnss " + late.fixes.string() + out,
               "overlap at only 0 fix(es), at least 3 are needed (60 outside the trajectory's time span");
@@ -279,7 +279,7 @@ TEST(GeorefCli, BadInputGivesAnErrorNamingTheFileAndField) {
   expectError(traj + " --gnss " + dir.file("missing.csv").string() + out,
               "missing.csv: cannot open the GNSS fixes file");
   expectError(traj + " --gnss " + input.fixes.string() + " --method pf6" + out,
-              "--method pf6 needs the IMU's absolute orientation, which a fixes CSV does not carry");
+              "georef method pf6 needs the IMU's absolute orientation, which a fixes CSV does not carry");
 }
 
 }  // namespace

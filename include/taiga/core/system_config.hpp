@@ -3,6 +3,7 @@
 // modules that own them land.
 
 #include "taiga/core/config.hpp"
+#include "taiga/core/georef_config.hpp"
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/core/recording_config.hpp"
@@ -15,6 +16,7 @@ struct SystemConfig final : ConfigSection {
   RecordingConfig recording;
   OdometryConfig odometry;
   MappingConfig mapping;
+  GeorefConfig georef;
 
   void visit(ConfigVisitor& v) override {
     v.section("rig", rig, "sensor rig: extrinsics, clock offset and units");
@@ -22,6 +24,7 @@ struct SystemConfig final : ConfigSection {
     v.section("odometry", odometry,
               "lidar-inertial odometry: preprocessing, registration, keyframes, IMU noise");
     v.section("mapping", mapping, "keyframe graph and loop closures");
+    v.section("georef", georef, "georeferencing with GNSS: post-fit method, output CRS, gating");
   }
 };
 
