@@ -10,19 +10,39 @@ namespace taiga::mapping {
 
 Mapper::Mapper(const MappingConfig& config, const OdometryConfig& odometry,
                const KeyframeStore& store)
-    : config_(config), odometry_(odometry), store_(store), graph_(config) {}
+    : config_(config), odometry_(odometry), store_(store), graph_(config) {
+  if (config.gnss_fusion) gnss_.emplace(config);
+}
 
 void Mapper::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body) {
   const std::size_t index = graph_.addKeyframe(T_odom_body);
   if (index != id) throw std::logic_error("Mapper: keyframes must arrive in id order");
+  keyframe_times_s_.push_back(t_s);
+  if (gnss_ && gnss_->afterKeyframe(graph_, keyframe_times_s_)) graph_.optimize();
   if (!config_.loop_closure) return;
   if (last_attempt_s_ && t_s - *last_attempt_s_ < config_.loop_min_interval_s) return;
   tryLoopClosure(index, t_s);
 }
 
+void Mapper::addGnssFix(const GnssFix& fix) {
+  if (gnss_) gnss_->addFix(fix);
+}
+
+void Mapper::finish() {
+  if (gnss_ && gnss_->finish(graph_)) graph_.optimize();
+}
+
+std::optional<GnssFusionReport> Mapper::gnssReport() const {
+  if (!gnss_) return std::nullopt;
+  return gnss_->report(graph_);
+}
+
 void Mapper::tryLoopClosure(std::size_t current, double t_s) {
   const std::optional<LoopCandidate> candidate = findLoopCandidate(graph_, current, config_);
   if (!candidate) return;
+  // The consistency test compares optimal costs: GNSS factors paced out of the last solve
+  // would be charged to the loop.
+  if (graph_.hasUnsolvedFactors()) graph_.optimize();
   last_attempt_s_ = t_s;
   LoopRecord record{.t_s = t_s,
                     .attempt = verifyLoop(graph_, store_, current, *candidate, config_, odometry_)};
@@ -60,6 +80,8 @@ void MappingThread::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_od
 
 void MappingThread::changeWorldFrame(const lie::SE3& T_new_old) { push(T_new_old); }
 
+void MappingThread::addGnssFix(const GnssFix& fix) { push(fix); }
+
 void MappingThread::push(Message message) {
   {
     const std::lock_guard lock(mutex_);
@@ -80,6 +102,8 @@ void MappingThread::work() {
     try {
       if (const auto* keyframe = std::get_if<KeyframeMessage>(&message)) {
         mapper_.addKeyframe(keyframe->id, keyframe->t_s, keyframe->T_odom_body);
+      } else if (const auto* fix = std::get_if<GnssFix>(&message)) {
+        mapper_.addGnssFix(*fix);
       } else {
         mapper_.changeWorldFrame(std::get<lie::SE3>(message));
       }
@@ -100,6 +124,10 @@ Mapper& MappingThread::finish() {
   wake_.notify_all();
   if (worker_.joinable()) worker_.join();
   if (error_) std::rethrow_exception(error_);
+  if (!finished_) {
+    finished_ = true;
+    mapper_.finish();
+  }
   return mapper_;
 }
 

@@ -6,7 +6,9 @@
 
 #include <array>
 #include <memory>
+#include <stdexcept>
 
+#include "taiga/backend/gnss_factor.hpp"
 #include "taiga/backend/position_factor.hpp"
 #include "taiga/backend/relative_pose_factor.hpp"
 #include "taiga/backend/state_blocks.hpp"
@@ -49,6 +51,38 @@ RelativePose PoseGraph::odometryBetween(std::size_t from, std::size_t to) const 
 void PoseGraph::changeWorldFrame(const lie::SE3& T_new_old) {
   for (lie::SE3& pose : odometry_poses_) pose = T_new_old * pose;
   for (lie::SE3& pose : poses_) pose = T_new_old * pose;
+  if (T_enu_world_) setEnuWorld(*T_enu_world_ * T_new_old.inverse());
+}
+
+void PoseGraph::setEnuWorld(const lie::SE3& T_enu_world) {
+  std::array<double, backend::kEnuWorldSize> block{};
+  backend::writeEnuWorldBlock(T_enu_world, block.data());
+  T_enu_world_ = backend::enuWorldFromBlock(block.data());
+  unsolved_ = unsolved_ || !gnss_.empty();
+}
+
+void PoseGraph::addGnss(const GnssObservation& observation) {
+  if (!T_enu_world_) throw std::logic_error("PoseGraph::addGnss before setEnuWorld");
+  if (observation.keyframe >= size()) throw std::logic_error("PoseGraph::addGnss: no such keyframe");
+  gnss_.push_back(observation);
+  unsolved_ = true;
+}
+
+std::vector<double> PoseGraph::gnssWhitenedResiduals() const {
+  std::vector<double> norms;
+  if (!T_enu_world_) return norms;
+  std::array<double, backend::kEnuWorldSize> enu{};
+  backend::writeEnuWorldBlock(*T_enu_world_, enu.data());
+  for (const GnssObservation& g : gnss_) {
+    PoseBlock pose{};
+    backend::writePoseBlock(poses_[g.keyframe], pose.data());
+    const backend::GnssFactor factor(g.d_body, g.p_enu, g.covariance_enu_m2);
+    const double* parameters[] = {pose.data(), enu.data()};
+    Eigen::Vector3d r;
+    factor.Evaluate(parameters, r.data(), nullptr);
+    norms.push_back(r.norm());
+  }
+  return norms;
 }
 
 void PoseGraph::addLoop(const RelativePose& loop) { loops_.push_back(loop); }
@@ -93,6 +127,20 @@ double PoseGraph::optimize() {
     problem.AddResidualBlock(new backend::PositionFactor(position.p_world, position.covariance),
                              loss, blocks[position.keyframe].data());
   }
+  // The ENU block is free in yaw and translation; see the header for the gauge.
+  std::array<double, backend::kEnuWorldSize> enu{};
+  if (!gnss_.empty()) {
+    backend::writeEnuWorldBlock(*T_enu_world_, enu.data());
+    problem.AddParameterBlock(enu.data(), backend::kEnuWorldSize);
+    for (const GnssObservation& g : gnss_) {
+      ceres::LossFunction* robust =
+          g.huber_sigmas > 0.0 ? new ceres::HuberLoss(g.huber_sigmas) : nullptr;
+      ceres::LossFunction* loss =
+          g.weight == 1.0 ? robust : new ceres::ScaledLoss(robust, g.weight, ceres::TAKE_OWNERSHIP);
+      problem.AddResidualBlock(new backend::GnssFactor(g.d_body, g.p_enu, g.covariance_enu_m2),
+                               loss, blocks[g.keyframe].data(), enu.data());
+    }
+  }
   if (positions_.empty()) problem.SetParameterBlockConstant(blocks.front().data());
 
   ceres::Solver::Options options;
@@ -103,6 +151,8 @@ double PoseGraph::optimize() {
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   for (std::size_t k = 0; k < size(); ++k) poses_[k] = backend::poseFromBlock(blocks[k].data());
+  if (!gnss_.empty()) T_enu_world_ = backend::enuWorldFromBlock(enu.data());
+  unsolved_ = false;
   cost_ = summary.final_cost;
   return cost_;
 }

@@ -3,10 +3,13 @@
 // the measurements, so that no term hides behind a zero residual.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <numbers>
 #include <random>
 #include <vector>
 
 #include "../imu/imu_test_motion.hpp"
+#include "taiga/backend/gnss_factor.hpp"
 #include "taiga/backend/imu_factor.hpp"
 #include "taiga/backend/pose_factor.hpp"
 #include "taiga/backend/position_factor.hpp"
@@ -127,6 +130,42 @@ TEST(FactorJacobians, PositionFactorMatchesNumericalDifferentiation) {
     const PositionFactor factor(randomState(rng).T_world_body().translation(), covariance);
     EXPECT_LT(worstJacobianError(factor, {vec(randomState(rng).pose)}), 1e-6);
   }
+}
+
+TEST(FactorJacobians, GnssFactorMatchesNumericalDifferentiation) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity() * 0.8;
+  covariance(0, 1) = covariance(1, 0) = 0.3;
+  covariance(2, 2) = 2.5;
+  for (int trial = 0; trial < 5; ++trial) {
+    // A lever arm, a fix far from the prediction and a yaw away from zero: every term counts.
+    const Eigen::Vector3d d_body(n(rng), n(rng), 0.5 * n(rng));
+    const GnssFactor factor(d_body, {20 * n(rng), 20 * n(rng), n(rng)}, covariance);
+    const std::vector<double> enu{30 * n(rng), 30 * n(rng), 2 * n(rng), 2 * n(rng)};
+    EXPECT_LT(worstJacobianError(factor, {vec(randomState(rng).pose), enu}), 1e-6);
+  }
+}
+
+TEST(FactorJacobians, GnssFactorResidualIsTheWhitenedEnuDifference) {
+  // 90 deg yaw: world x is north. A keyframe at (2, 0, 0) turned 90 deg, antenna 1 m ahead of
+  // it (body x = world y): world (2, 1, 0), ENU (-1, 2, 0) + t (10, 20, 1) = (9, 22, 1).
+  const lie::SE3 T_world_body(lie::SO3::fromRollPitchYaw(0, 0, std::numbers::pi / 2), {2, 0, 0});
+  std::array<double, kPoseSize> pose{};
+  writePoseBlock(T_world_body, pose.data());
+  const std::array<double, kEnuWorldSize> enu{10, 20, 1, std::numbers::pi / 2};
+  const GnssFactor factor({1, 0, 0}, {9, 22, 3}, Eigen::Vector3d(4, 4, 16).asDiagonal());
+  const double* parameters[] = {pose.data(), enu.data()};
+  Eigen::Vector3d r;
+  ASSERT_TRUE(factor.Evaluate(parameters, r.data(), nullptr));
+  EXPECT_NEAR(r.x(), 0.0, 1e-12);
+  EXPECT_NEAR(r.y(), 0.0, 1e-12);
+  EXPECT_NEAR(r.z(), -2.0 / 4.0, 1e-12);  // 2 m low, sigma 4 m
+  // The block round trip keeps yaw and translation.
+  const lie::SE3 T_enu_world = enuWorldFromBlock(enu.data());
+  std::array<double, kEnuWorldSize> again{};
+  writeEnuWorldBlock(T_enu_world, again.data());
+  for (int i = 0; i < kEnuWorldSize; ++i) EXPECT_NEAR(again[i], enu[i], 1e-12);
 }
 
 TEST(FactorJacobians, StatePriorMatchesNumericalDifferentiation) {

@@ -2,7 +2,8 @@
 // The mapping back end of thesis 3.1.2: keyframes from the odometry enter the pose graph, loop
 // closures are searched at most once per loop_min_interval_s of recording time and kept when
 // they verify (loop_closure.hpp) and agree with the graph (the chi^2 of the cost they add).
-// MappingThread runs it beside the odometry, so the odometry never waits for it.
+// MappingThread runs it beside the odometry, so the odometry never waits for it. With
+// gnss_fusion on, GNSS fixes enter the graph too (gnss_fusion.hpp).
 
 #include <condition_variable>
 #include <cstddef>
@@ -16,6 +17,8 @@
 
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
+#include "taiga/core/sensor_samples.hpp"
+#include "taiga/mapping/gnss_fusion.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/mapping/loop_closure.hpp"
 #include "taiga/mapping/pose_graph.hpp"
@@ -38,6 +41,14 @@ class Mapper {
   void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
   /// The odometry re-expressed its world frame (gravity levelling): T_new_old.
   void changeWorldFrame(const lie::SE3& T_new_old) { graph_.changeWorldFrame(T_new_old); }
+  /// A GNSS fix (recording clock); used when MappingConfig::gnss_fusion is on, ignored
+  /// otherwise. It waits for the first keyframe at or after its time (gnss_fusion.hpp).
+  void addGnssFix(const GnssFix& fix);
+  /// End of the input: solves the graph once more when GNSS factors arrived since its last
+  /// solve. Call once, after the last keyframe and fix.
+  void finish();
+  /// What became of the GNSS fixes and the estimated T_enu_world (none with fusion off).
+  std::optional<GnssFusionReport> gnssReport() const;
 
   const PoseGraph& graph() const { return graph_; }
   const std::vector<LoopRecord>& loopAttempts() const { return attempts_; }
@@ -50,6 +61,8 @@ class Mapper {
   OdometryConfig odometry_;
   const KeyframeStore& store_;
   PoseGraph graph_;
+  std::vector<double> keyframe_times_s_;
+  std::optional<GnssFusion> gnss_;
   std::optional<double> last_attempt_s_;
   std::vector<LoopRecord> attempts_;
 };
@@ -66,8 +79,11 @@ class MappingThread {
 
   void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
   void changeWorldFrame(const lie::SE3& T_new_old);
-  /// Waits until every message is handled, stops the thread and hands out the mapper. Rethrows
-  /// what the thread threw.
+  /// Fixes are handled in the order of the calls, interleaved with the keyframes, so the
+  /// result depends on that order only, not on the thread's timing.
+  void addGnssFix(const GnssFix& fix);
+  /// Waits until every message is handled, stops the thread, finishes the mapper
+  /// (Mapper::finish) and hands it out. Rethrows what the thread threw.
   Mapper& finish();
 
  private:
@@ -76,7 +92,7 @@ class MappingThread {
     double t_s;
     lie::SE3 T_odom_body;
   };
-  using Message = std::variant<KeyframeMessage, lie::SE3>;
+  using Message = std::variant<KeyframeMessage, lie::SE3, GnssFix>;
   void push(Message message);
   void work();
 
@@ -85,6 +101,7 @@ class MappingThread {
   std::condition_variable wake_;
   std::deque<Message> queue_;
   bool stopping_ = false;
+  bool finished_ = false;
   std::exception_ptr error_;
   std::thread worker_;
 };

@@ -5,11 +5,16 @@
 // absolute factor arrives; in between, a new keyframe is placed by chaining the odometry onto
 // the corrected pose of the previous one.
 //
-// Gauge: without absolute factors the first keyframe is held fixed, so the corrected map stays
-// in the odometry's world frame at its start.
+// Gauge: without absolute position factors the first keyframe is held fixed, so the corrected
+// map stays in the odometry's world frame at its start. GNSS factors (addGnss, backend/
+// gnss_factor.hpp) relate the map to ENU through the estimated T_enu_world (yaw and translation),
+// so they do not fix the world frame: with them the first keyframe stays fixed too, otherwise the
+// world frame and T_enu_world could slide together (a 4-DoF null space) and noisy GNSS heights
+// could tilt the whole map away from gravity.
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "taiga/core/mapping_config.hpp"
@@ -24,6 +29,19 @@ struct RelativePose {
   std::size_t to = 0;
   lie::SE3 T_from_to;
   lie::Matrix6 covariance = lie::Matrix6::Identity();
+};
+
+/// A GNSS fix attached to a keyframe (backend/gnss_factor.hpp): the antenna at the fix time in
+/// the keyframe's body frame, and the fix in local ENU with its covariance.
+struct GnssObservation {
+  std::size_t keyframe = 0;
+  Eigen::Vector3d d_body = Eigen::Vector3d::Zero();                 ///< m
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();                  ///< m
+  Eigen::Matrix3d covariance_enu_m2 = Eigen::Matrix3d::Identity();  ///< m^2
+  double huber_sigmas = 0.0;  ///< > 0: Huber kernel beyond that many (whitened) sigmas
+  /// Scales the (robustified) cost, e.g. 1/f for errors correlated in time (gnss_fusion.hpp):
+  /// the Huber threshold stays in sigmas of the reported covariance.
+  double weight = 1.0;
 };
 
 class PoseGraph {
@@ -46,8 +64,21 @@ class PoseGraph {
   void addPosition(std::size_t keyframe, const Eigen::Vector3d& p_world,
                    const Eigen::Matrix3d& covariance, double huber_sigmas = 0.0);
 
+  /// Starts (or resets) the estimate of T_enu_world; its roll and pitch are dropped. Needed
+  /// before addGnss().
+  void setEnuWorld(const lie::SE3& T_enu_world);
+  /// The current T_enu_world (yaw and translation), once set.
+  const std::optional<lie::SE3>& enuWorld() const { return T_enu_world_; }
+  /// A GNSS factor; the graph must have T_enu_world (setEnuWorld) and the keyframe.
+  void addGnss(const GnssObservation& observation);
+  const std::vector<GnssObservation>& gnss() const { return gnss_; }
+  /// Whitened residual norm of each GNSS factor at the current poses and T_enu_world (in
+  /// sigmas of the fix's covariance; the Huber kernel down-weights those above huber_sigmas).
+  std::vector<double> gnssWhitenedResiduals() const;
+
   /// Re-expresses every pose in a new world frame (T_new_old * pose); the factors are relative
-  /// and stay as they are. Only without absolute factors.
+  /// and stay as they are, and T_enu_world becomes T_enu_world * T_new_old^-1 (its tilt
+  /// dropped). Only without absolute position factors.
   void changeWorldFrame(const lie::SE3& T_new_old);
 
   /// Solves for every keyframe pose; returns the final cost.
@@ -55,6 +86,8 @@ class PoseGraph {
   /// The cost at the current poses after the last optimize() (0 before); keyframes added since
   /// sit on their odometry factors and add nothing.
   double cost() const { return cost_; }
+  /// Whether factors that change the optimum (GNSS) were added since the last optimize().
+  bool hasUnsolvedFactors() const { return unsolved_; }
 
   std::size_t size() const { return odometry_poses_.size(); }
   /// The corrected pose of a keyframe.
@@ -81,6 +114,9 @@ class PoseGraph {
   std::vector<double> path_lengths_m_;
   std::vector<RelativePose> loops_;
   std::vector<Position> positions_;
+  std::vector<GnssObservation> gnss_;
+  std::optional<lie::SE3> T_enu_world_;
+  bool unsolved_ = false;
   double cost_ = 0.0;
 };
 
