@@ -45,10 +45,22 @@ int run(const RunOptions& options) {
                s.realtime->dropped_scans, s.realtime->latency_p50_ms, s.realtime->latency_p95_ms,
                s.realtime->latency_max_ms);
   }
+  if (s.georef) {
+    if (s.georef->skipped.empty()) {
+      fmt::print("georef     {} of {} GNSS fixes ({}), residual {:.2f} m horizontal; 1-sigma {:.2f} m "
+                 "east, {:.2f} m north, {:.2f} deg yaw; EPSG:{} in georef/\n",
+                 s.georef->inliers, s.georef->fixes, s.georef->method, s.georef->horizontal_rms_m,
+                 s.georef->sigma[0], s.georef->sigma[1], s.georef->sigma[5] * 57.29577951308232,
+                 s.georef->epsg);
+    } else {
+      fmt::print("georef     not georeferenced: {}\n", s.georef->skipped);
+    }
+  }
   fmt::print(
       "outputs    {}/ (trajectory.tum, trajectory_imu.tum, trajectory_odometry.tum, keyframes.tum, "
-      "keyframes/, map.las{}, loops.csv, timing.csv, scans.csv, summary.json)\n",
-      options.out, options.ply ? ", map.ply" : "");
+      "keyframes/, map.las{}, loops.csv, timing.csv, scans.csv, summary.json{})\n",
+      options.out, options.ply ? ", map.ply" : "",
+      s.georef && s.georef->skipped.empty() ? ", georef/" : "");
   return kExitOk;
 }
 

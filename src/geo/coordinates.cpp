@@ -66,6 +66,9 @@ CoordinateConverter::CoordinateConverter(int epsg) : epsg_(epsg), proj_(std::mak
         code, found));
   }
   name_ = proj_get_name(crs) ? proj_get_name(crs) : code;
+  // WKT1 as GDAL writes it: what LAS 1.4 readers (PDAL, LAStools, CloudCompare) expect.
+  const char* wkt = proj_as_wkt(context, crs, PJ_WKT1_GDAL, nullptr);
+  wkt_ = wkt ? wkt : "";
   // From the CRS's own geodetic base (ETRS89 for 3067): a pure conversion, no datum shift.
   PJ* base = proj_crs_get_geodetic_crs(context, crs);
   PJ* to_projected = proj_create_crs_to_crs_from_pj(context, base, crs, nullptr, nullptr);

@@ -106,7 +106,7 @@ class MapSink {
 };
 
 /// Keeps the channels the LAS and PLY outputs carry (positions, times, intensities, rings).
-PointCloud toOutputFrame(PointCloud cloud_in_body, const lie::SE3& T_out_body) {
+PointCloud toOutputFrame(PointCloud cloud_in_body, const Eigen::Affine3d& T_out_body) {
   for (Eigen::Vector3d& p : cloud_in_body.positions) p = T_out_body * p;
   cloud_in_body.columns.clear();
   return cloud_in_body;
@@ -148,7 +148,8 @@ MapExportSummary exportMap(const KeyframeStore& store,
   bool has_times = false, has_intensities = false, has_rings = false;
   for (std::uint64_t id = 0; id < store.size(); ++id) {
     const PointCloud cloud_out =
-        toOutputFrame(store.load(id), options.T_out_world * poses_T_world_body[id]);
+        toOutputFrame(store.load(id),
+                      options.T_out_world * Eigen::Affine3d(poses_T_world_body[id].matrix()));
     summary.points_read += cloud_out.size();
     ++summary.keyframes;
     if (!grid) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "recording_feed.hpp"
+#include "run_georef.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/core/progress.hpp"
@@ -92,6 +93,26 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
                       {{"p50", s.realtime->latency_p50_ms},
                        {"p95", s.realtime->latency_p95_ms},
                        {"max", s.realtime->latency_max_ms}}}};
+  }
+  if (s.georef) {
+    const GeorefRunReport& g = *s.georef;
+    nlohmann::ordered_json georef = {{"fixes", g.fixes}};
+    if (!g.skipped.empty()) {
+      georef["skipped"] = g.skipped;
+    } else {
+      constexpr double kDeg = 57.29577951308232;
+      georef.update({{"method", g.method},
+                     {"epsg", g.epsg},
+                     {"inliers", g.inliers},
+                     {"outliers", g.outliers},
+                     {"horizontal_rms_m", g.horizontal_rms_m},
+                     {"vertical_rms_m", g.vertical_rms_m},
+                     {"sigma", {{"east_m", g.sigma[0]}, {"north_m", g.sigma[1]},
+                                {"up_m", g.sigma[2]}, {"roll_deg", g.sigma[3] * kDeg},
+                                {"pitch_deg", g.sigma[4] * kDeg}, {"yaw_deg", g.sigma[5] * kDeg}}},
+                     {"map_export_s", g.map_export_s}});
+    }
+    j["georef"] = georef;
   }
   openOutput(path) << j.dump(2) << "\n";
 }
@@ -215,15 +236,24 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       ++summary.keyframes;
     }
   };
+  // GNSS fixes are kept for the georeferencing at the end (and the IMU's absolute orientation,
+  // which only the pf6 fit uses).
+  georef::GnssInput gnss{.from_recording = true};
+  const bool keep_imu_orientation = config.georef.method == "pf6";
   // Returns whether the event was a scan.
   auto handle = [&](const io::RecordingEvent& event) {
     if (const auto* imu = std::get_if<ImuSample>(&event)) {
       odometry.addImu(*imu);
       ++summary.imu_samples;
+      if (keep_imu_orientation && imu->orientation) gnss.imu_with_orientation.push_back(*imu);
+      return false;
+    }
+    if (const auto* fix = std::get_if<GnssFix>(&event)) {
+      gnss.fixes.push_back(*fix);
       return false;
     }
     const auto* scan = std::get_if<io::Scan>(&event);
-    if (!scan) return false;  // GNSS fixes: used by georeferencing, not by the odometry
+    if (!scan) return false;
     ++summary.scans;
     scan_read_ms = std::exchange(read_ms_since_scan, 0.0);
     const std::optional<ScanOutcome> outcome = odometry.addScan(*scan);
@@ -278,8 +308,9 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   }
   // The odometry as it ran online; then every pose corrected by the mapping graph.
   io::writeTum(options.out_dir / "trajectory_odometry.tum", trajectory);
-  io::writeTum(options.out_dir / "trajectory.tum",
-               mapping::correctedTrajectory(trajectory, mapper.graph(), keyframe_times_s));
+  const Trajectory corrected =
+      mapping::correctedTrajectory(trajectory, mapper.graph(), keyframe_times_s);
+  io::writeTum(options.out_dir / "trajectory.tum", corrected);
   io::writeTum(options.out_dir / "trajectory_imu.tum",
                mapping::correctedTrajectory(trajectory_imu, mapper.graph(), keyframe_times_s));
   writeLoops(options.out_dir / "loops.csv", mapper.loopAttempts());
@@ -294,6 +325,12 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                          {.voxel_m = options.map_voxel_m, .write_ply = options.write_ply});
   summary.map_points = map.points_written;
   summary.map_export_s = std::chrono::duration<double>(Clock::now() - export_start).count();
+  if (!gnss.fixes.empty()) {
+    summary.georef = georeferenceRun(
+        corrected, gnss, config, recording_path.string(),
+        {.store = keyframe_store, .poses_T_world_body = keyframe_poses, .voxel_m = options.map_voxel_m},
+        options.out_dir);
+  }
 
   summary.duration_s = trajectory.endTime() - trajectory.startTime();
   summary.path_length_m = trajectory.pathLength();

@@ -53,6 +53,14 @@ TEST(CoordinateConverter, HelsinkiInTm35fin) {
   EXPECT_NEAR(enh.y(), 6672118.4, 0.1);
 }
 
+TEST(CoordinateConverter, GivesTheCrsAsWktForLasHeaders) {
+  const CoordinateConverter tm35fin(3067);
+  EXPECT_EQ(tm35fin.wkt().rfind("PROJCS[\"ETRS89 / TM35FIN(E,N)\"", 0), 0u) << tm35fin.wkt();
+  EXPECT_NE(tm35fin.wkt().find("AUTHORITY[\"EPSG\",\"3067\"]"), std::string::npos);
+  const CoordinateConverter utm(32635);
+  EXPECT_NE(utm.wkt().find("UTM zone 35N"), std::string::npos) << utm.wkt();
+}
+
 TEST(CoordinateConverter, UtmZonesNorthAndSouth) {
   // EPSG:32633, UTM 33N: central meridian 15 E; EPSG:32735, UTM 35S: 27 E with N0 = 10 000 km.
   const CoordinateConverter utm33n(32633), utm35s(32735);

@@ -19,6 +19,7 @@
 #include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
 #include "taiga/geo/coordinates.hpp"
+#include "taiga/io/las_reader.hpp"
 #include "taiga/io/trajectory_io.hpp"
 
 namespace taiga {
@@ -280,6 +281,91 @@ TEST(GeorefCli, BadInputGivesAnErrorNamingTheFileAndField) {
               "missing.csv: cannot open the GNSS fixes file");
   expectError(traj + " --gnss " + input.fixes.string() + " --method pf6" + out,
               "georef method pf6 needs the IMU's absolute orientation, which a fixes CSV does not carry");
+}
+
+// taiga run georeferences its own (loop-corrected) trajectory and map when the recording has
+// fixes. With exact fixes, what is left is the odometry's error; fixes that cannot be used leave
+// the run's other outputs intact and say why in summary.json.
+TEST(GeorefCli, TaigaRunGeoreferencesItsTrajectoryAndMapWhenTheRecordingHasFixes) {
+  test::TempDir dir;
+  const auto overrides = dir.write("exact.yaml", "gnss: {noise: false, world_yaw_deg: 30}\n");
+  const auto sim = dir.file("sim");
+  ASSERT_EQ(runTaiga("simulate --scenario handheld-loop --duration 30 --beams 32 --sub-rays 1 "
+                     "--seed 5 --overrides " + overrides.string() + " --out " + sim.string())
+                .exit_code,
+            0);
+  const auto run = dir.file("run");
+  const test::TaigaResult r = runTaiga("run " + (sim / "recording.bag").string() + " --config " +
+                                       (sim / "rig.yaml").string() + " --out " + run.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto summary = nlohmann::json::parse(readText(run / "summary.json"));
+  ASSERT_TRUE(summary.contains("georef")) << summary.dump(2);
+  EXPECT_EQ(summary["georef"]["method"], "robust");
+  EXPECT_GE(summary["georef"]["inliers"].get<int>(), 25);
+
+  const YAML::Node truth = YAML::LoadFile((sim / "georef_truth.yaml").string());
+  const Eigen::Matrix4d T_epsg_simworld = matrixOf(truth["T_epsg_world"]);
+  const Trajectory groundtruth = io::readTum(sim / "groundtruth.tum");
+  std::ifstream csv(run / "georef" / "trajectory_epsg3067.csv");
+  std::string line;
+  std::getline(csv, line);
+  double max_horizontal_m = 0.0, max_height_m = 0.0, max_yaw_deg = 0.0;
+  double min_e = 1e12, max_e = -1e12, min_n = 1e12, max_n = -1e12;
+  std::size_t rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<double> v;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) v.push_back(std::stod(cell));
+    ASSERT_EQ(v.size(), 5u) << line;
+    const lie::SE3 T_simworld_body = groundtruth.poseAt(v[0]);
+    const Eigen::Vector3d truth_grid =
+        (T_epsg_simworld * T_simworld_body.translation().homogeneous()).head<3>();
+    max_horizontal_m = std::max(max_horizontal_m, std::hypot(v[1] - truth_grid.x(),
+                                                             v[2] - truth_grid.y()));
+    max_height_m = std::max(max_height_m, std::abs(v[3] - truth_grid.z()));
+    const Eigen::Vector3d x_simworld = T_simworld_body.rotation().matrix().col(0);
+    const double truth_yaw_deg = std::atan2(x_simworld.y(), x_simworld.x()) * kDeg +
+                                 truth["yaw_grid_world_deg"].as<double>();
+    max_yaw_deg = std::max(max_yaw_deg, std::abs(std::remainder(v[4] - truth_yaw_deg, 360.0)));
+    min_e = std::min(min_e, v[1]), max_e = std::max(max_e, v[1]);
+    min_n = std::min(min_n, v[2]), max_n = std::max(max_n, v[2]);
+    ++rows;
+  }
+  EXPECT_GE(rows, 250u);  // one pose per scan
+  // A wrong frame anywhere (ENU vs grid, the 30 deg world turn, the meridian convergence of
+  // -2.2 deg) would be metres and degrees off.
+  EXPECT_LT(max_horizontal_m, 0.3);
+  EXPECT_LT(max_height_m, 0.3);
+  EXPECT_LT(max_yaw_deg, 1.0);
+
+  // The map in the grid, with the CRS in the LAS header.
+  const auto map_path = run / "georef" / "map_epsg3067.las";
+  const io::LasReader map(map_path);
+  EXPECT_GT(map.pointCount(), 100000u);
+  EXPECT_GT(map.header().min_m.x(), min_e - 60.0);
+  EXPECT_LT(map.header().max_m.x(), max_e + 60.0);
+  EXPECT_GT(map.header().min_m.y(), min_n - 60.0);
+  EXPECT_LT(map.header().max_m.y(), max_n + 60.0);
+  EXPECT_THAT(readText(map_path).substr(0, 20000), HasSubstr("ETRS89 / TM35FIN(E,N)"));
+
+  // Fixes that cannot be used (all between poses further apart than max_gap_s): the run still
+  // succeeds and says why it is not georeferenced.
+  std::string config = readText(sim / "rig.yaml");
+  const std::string gap_key = "max_gap_s: ";
+  const std::size_t at = config.find(gap_key);
+  ASSERT_NE(at, std::string::npos);
+  config.insert(at + gap_key.size(), "0.001 # ");
+  const auto gating = dir.write("gating.yaml", config);
+  const auto gated_run = dir.file("gated");
+  ASSERT_EQ(runTaiga("run " + (sim / "recording.bag").string() + " --config " + gating.string() +
+                     " --out " + gated_run.string())
+                .exit_code,
+            0);
+  const auto gated = nlohmann::json::parse(readText(gated_run / "summary.json"));
+  EXPECT_THAT(gated.at("georef").at("skipped").get<std::string>(),
+              HasSubstr("overlap at only 0 fix(es)"));
+  EXPECT_TRUE(std::filesystem::exists(gated_run / "trajectory.tum"));
+  EXPECT_FALSE(std::filesystem::exists(gated_run / "georef"));
 }
 
 }  // namespace

@@ -77,7 +77,7 @@ TEST(MapExport, EveryPointLandsInTheWorldWithItsTimeIntensityRingAndKeyframe) {
   std::vector<lie::SE3> corrected = f.poses;
   corrected[2] = lie::SE3(lie::SO3(), Eigen::Vector3d(0, 0, 1)) * corrected[2];
   exportMap(f.store, corrected, las,
-            {.T_out_world = lie::SE3(lie::SO3(), Eigen::Vector3d(385000.0, 6672000.0, 0.0))});
+            {.T_out_world = Eigen::Affine3d(Eigen::Translation3d(385000.0, 6672000.0, 0.0))});
   const PointCloud moved = io::LasReader(las).readStrided(1);
   EXPECT_NEAR(moved.positions[0].x() - map.positions[0].x(), 385000.0, 0.001);
   EXPECT_NEAR(moved.positions[100].z() - map.positions[100].z(), 1.0, 0.001);

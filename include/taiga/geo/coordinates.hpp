@@ -56,6 +56,8 @@ class CoordinateConverter {
   int epsg() const { return epsg_; }
   /// The CRS's name in the EPSG database, e.g. "ETRS89 / TM35FIN(E,N)".
   const std::string& crsName() const { return name_; }
+  /// The CRS as OGC WKT1 (GDAL's flavour), for LAS headers.
+  const std::string& wkt() const { return wkt_; }
 
   /// Easting, northing (m) and the unchanged ellipsoidal height (m).
   Eigen::Vector3d toProjected(const Geodetic& point) const;
@@ -78,6 +80,7 @@ class CoordinateConverter {
   struct Proj;
   int epsg_;
   std::string name_;
+  std::string wkt_;
   std::unique_ptr<Proj> proj_;
 };
 

@@ -13,6 +13,7 @@
 // time). Without decimation nothing but one keyframe is held, except for map.ply, which is
 // written at the end from the whole map in RAM (as io::writePly needs).
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -26,9 +27,10 @@ namespace taiga::mapping {
 struct MapExportOptions {
   double voxel_m = 0.0;  ///< > 0: one point per voxel of this edge, m (`--map-voxel`)
   bool write_ply = false;  ///< also the same points as binary PLY (las path with .ply)
-  /// Output frame: p_out = T_out_world * T_world_body * p_body (e.g. a georeferencing's
-  /// T_epsg_world; identity: the map in the odometry's world frame).
-  lie::SE3 T_out_world;
+  /// Output frame: p_out = T_out_world * T_world_body * p_body; affine, so that it can carry a
+  /// projected grid's scale factor (e.g. a georeferencing's T_epsg_world; identity: the map in
+  /// the odometry's world frame).
+  Eigen::Affine3d T_out_world = Eigen::Affine3d::Identity();
   std::string wkt;  ///< OGC WKT of the output frame for the LAS header; empty: local coordinates
 };
 

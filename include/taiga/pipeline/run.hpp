@@ -17,7 +17,11 @@
 //   timing.csv           per scan: t_s and the stage durations in ms (docs/formats.md)
 //   scans.csv            per scan: registration diagnostics (fitness, iterations, lidar factor)
 //   summary.json         counts, per-scan time statistics, real-time factor, peak memory
+//   georef/              with GNSS fixes in the recording: trajectory.tum fitted to them
+//                        (config georef:), in the projected CRS: trajectory_epsgNNNN.csv,
+//                        trajectory.geojson, georef.yaml and map_epsgNNNN.las (run_georef.hpp)
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -46,6 +50,19 @@ struct RealtimeReport {
   double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_max_ms = 0.0;
 };
 
+/// The georeferencing at the end of a run whose recording has GNSS fixes.
+struct GeorefRunReport {
+  std::size_t fixes = 0;  ///< GNSS fixes in the recording
+  std::string skipped;    ///< why the run is not georeferenced; empty when it is
+  std::string method;
+  int epsg = 0;
+  std::size_t inliers = 0, outliers = 0;
+  double horizontal_rms_m = 0.0, vertical_rms_m = 0.0;
+  /// 1-sigma of the fit: east, north, up (m), roll, pitch, yaw (rad).
+  Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();
+  double map_export_s = 0.0;  ///< georef/map_epsgNNNN.las
+};
+
 struct RunSummary {
   std::size_t scans = 0;            ///< scans read
   std::size_t scans_processed = 0;  ///< scans that gave a state
@@ -64,6 +81,7 @@ struct RunSummary {
   double peak_memory_mb = 0.0;
   std::string initialization;
   std::optional<RealtimeReport> realtime;  ///< with --realtime only
+  std::optional<GeorefRunReport> georef;   ///< when the recording has GNSS fixes
 };
 
 /// Runs the odometry over `recording` and writes the outputs into options.out_dir (created).

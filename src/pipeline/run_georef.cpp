@@ -1,0 +1,59 @@
+#include "run_georef.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+
+#include "taiga/core/errors.hpp"
+#include "taiga/core/log.hpp"
+#include "taiga/geo/coordinates.hpp"
+#include "taiga/georef/georeference.hpp"
+#include "taiga/mapping/map_export.hpp"
+
+namespace taiga::pipeline {
+
+GeorefRunReport georeferenceRun(const Trajectory& trajectory, const georef::GnssInput& gnss,
+                                const SystemConfig& config, const std::string& recording_name,
+                                const RunMap& map, const std::filesystem::path& out_dir) {
+  GeorefRunReport report;
+  report.fixes = gnss.fixes.size();
+  report.method = config.georef.method;
+  report.epsg = config.georef.epsg;
+  georef::Georeference result;
+  try {
+    result = georef::georeference(trajectory, gnss, georef::settingsFrom(config.georef),
+                                  config.rig, "trajectory.tum", recording_name);
+  } catch (const InputError& e) {
+    report.skipped = e.what();
+    logger().warn("not georeferenced: {}", report.skipped);
+    return report;
+  }
+  const std::filesystem::path dir = out_dir / "georef";
+  georef::writeGeoreference(dir, result, "trajectory");
+  const georef::GeorefFit& fit = result.report.fit;
+  report.inliers = fit.inliers;
+  report.outliers = fit.outliers;
+  report.horizontal_rms_m = fit.horizontal_rms_m;
+  report.vertical_rms_m = fit.vertical_rms_m;
+  report.sigma = fit.sigma;
+
+  // The map through the tangent-plane approximation at the ENU origin (scale and meridian
+  // convergence included): 0.2 mm off at 50 m from the origin, 1.8 mm at 150 m (tests/geo).
+  const auto export_start = std::chrono::steady_clock::now();
+  mapping::MapExportOptions options;
+  options.voxel_m = map.voxel_m;
+  options.T_out_world = Eigen::Affine3d(result.report.T_epsg_world);
+  options.wkt = geo::CoordinateConverter(report.epsg).wkt();
+  mapping::exportMap(map.store, map.poses_T_world_body,
+                     dir / fmt::format("map_epsg{}.las", report.epsg), options);
+  report.map_export_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - export_start).count();
+  logger().info("georeferenced ({}): {} of {} fixes, residual RMS {:.2f} m horizontal, 1-sigma "
+                "{:.2f} m east {:.2f} m north {:.2f} deg yaw; {}",
+                report.method, report.inliers, report.fixes, report.horizontal_rms_m,
+                report.sigma[0], report.sigma[1], report.sigma[5] * 57.29577951308232,
+                dir.string());
+  return report;
+}
+
+}  // namespace taiga::pipeline
