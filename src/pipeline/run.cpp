@@ -191,6 +191,9 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   // odometry does not wait for it, and its trajectory does not depend on it.
   mapping::MappingThread mapping_thread(config.mapping, config.odometry, keyframe_store);
   std::vector<double> keyframe_times_s;
+  // The live georeference of each scan's pose, from the fixes received so far (georef/online.hpp).
+  std::optional<georef::OnlineGeoreferencer> online_georef;
+  std::vector<OnlineGridPose> online_poses;
 
   Trajectory trajectory, trajectory_imu;
   RunSummary summary;
@@ -210,6 +213,13 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       trajectory_imu = transformed(trajectory_imu, T_new_old);
       keyframe_store.setPoses(transformedPoses(keyframe_store.poses(), T_new_old));
       mapping_thread.changeWorldFrame(T_new_old);
+      if (online_georef) online_georef->changeWorldFrame(T_new_old);
+    }
+    if (online_georef) {
+      online_georef->addPose(outcome.t_s, outcome.T_world_body);
+      if (auto grid = online_georef->toGrid(outcome.t_s, outcome.T_world_body))
+        online_poses.push_back({*grid, online_georef->estimate()->fit.sigma,
+                                online_georef->estimate()->fixes});
     }
     appendIfLater(trajectory, outcome.t_s, outcome.T_world_body);
     for (const StampedPose& p : outcome.imu_rate_poses)
@@ -250,6 +260,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
     }
     if (const auto* fix = std::get_if<GnssFix>(&event)) {
       gnss.fixes.push_back(*fix);
+      if (!online_georef) online_georef.emplace(georef::settingsFrom(config.georef));
+      online_georef->addFix(*fix);
       return false;
     }
     const auto* scan = std::get_if<io::Scan>(&event);
@@ -325,6 +337,9 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                          {.voxel_m = options.map_voxel_m, .write_ply = options.write_ply});
   summary.map_points = map.points_written;
   summary.map_export_s = std::chrono::duration<double>(Clock::now() - export_start).count();
+  if (!online_poses.empty()) {
+    writeOnlineGeoreference(options.out_dir / "georef", online_poses, config.georef.epsg);
+  }
   if (!gnss.fixes.empty()) {
     summary.georef = georeferenceRun(
         corrected, gnss, config, recording_path.string(),

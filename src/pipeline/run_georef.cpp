@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <fstream>
 
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
@@ -54,6 +55,22 @@ GeorefRunReport georeferenceRun(const Trajectory& trajectory, const georef::Gnss
                 report.sigma[0], report.sigma[1], report.sigma[5] * 57.29577951308232,
                 dir.string());
   return report;
+}
+
+void writeOnlineGeoreference(const std::filesystem::path& dir,
+                             const std::vector<OnlineGridPose>& poses, int epsg) {
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path path = dir / fmt::format("trajectory_online_epsg{}.csv", epsg);
+  std::ofstream out(path);
+  if (!out) throw InputError(fmt::format("{}: cannot write", path.string()));
+  out << "t_s,easting_m,northing_m,height_m,yaw_grid_deg,sigma_east_m,sigma_north_m,sigma_up_m,"
+         "sigma_yaw_deg,fixes\n";
+  for (const OnlineGridPose& p : poses) {
+    out << fmt::format("{:.6f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{}\n",
+                       p.pose.t_s, p.pose.easting_m, p.pose.northing_m, p.pose.height_m,
+                       p.pose.yaw_grid_deg, p.sigma[0], p.sigma[1], p.sigma[2],
+                       p.sigma[5] * 57.29577951308232, p.fixes);
+  }
 }
 
 }  // namespace taiga::pipeline

@@ -12,6 +12,7 @@
 #include "taiga/core/system_config.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/georef/georef_files.hpp"
+#include "taiga/georef/online.hpp"
 #include "taiga/lie/se3.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/pipeline/run.hpp"
@@ -27,5 +28,16 @@ struct RunMap {
 GeorefRunReport georeferenceRun(const Trajectory& trajectory, const georef::GnssInput& gnss,
                                 const SystemConfig& config, const std::string& recording_name,
                                 const RunMap& map, const std::filesystem::path& out_dir);
+
+/// A scan's pose in the grid as the online georeferencer gave it when the scan was processed.
+struct OnlineGridPose {
+  georef::GridPose pose;
+  Eigen::Matrix<double, 6, 1> sigma;  ///< of the estimate then: east, north, up, roll, pitch, yaw
+  std::size_t fixes = 0;              ///< fixes the estimate used
+};
+
+/// DIR/trajectory_online_epsgNNNN.csv: one row per scan from the first online estimate on.
+void writeOnlineGeoreference(const std::filesystem::path& dir,
+                             const std::vector<OnlineGridPose>& poses, int epsg);
 
 }  // namespace taiga::pipeline

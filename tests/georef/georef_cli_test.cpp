@@ -338,6 +338,21 @@ TEST(GeorefCli, TaigaRunGeoreferencesItsTrajectoryAndMapWhenTheRecordingHasFixes
   EXPECT_LT(max_height_m, 0.3);
   EXPECT_LT(max_yaw_deg, 1.0);
 
+  // The live estimate, scan by scan: it starts once the heading is determined and ends at the
+  // truth too (with exact fixes, within the odometry's error).
+  std::ifstream online(run / "georef" / "trajectory_online_epsg3067.csv");
+  std::string last_row;
+  std::size_t online_rows = 0;
+  for (std::getline(online, line); std::getline(online, line); ++online_rows) last_row = line;
+  EXPECT_GT(online_rows, 150u);
+  std::vector<double> last;
+  std::stringstream last_cells(last_row);
+  for (std::string cell; std::getline(last_cells, cell, ',');) last.push_back(std::stod(cell));
+  ASSERT_EQ(last.size(), 10u) << last_row;
+  const Eigen::Vector3d last_truth =
+      (T_epsg_simworld * groundtruth.poseAt(last[0]).translation().homogeneous()).head<3>();
+  EXPECT_LT(std::hypot(last[1] - last_truth.x(), last[2] - last_truth.y()), 0.3);
+
   // The map in the grid, with the CRS in the LAS header.
   const auto map_path = run / "georef" / "map_epsg3067.las";
   const io::LasReader map(map_path);
