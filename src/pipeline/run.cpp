@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -65,8 +67,29 @@ Trajectory transformed(const Trajectory& trajectory, const lie::SE3& T_new_old) 
   return out;
 }
 
+// GNSS fused in the mapping graph (mapping.gnss_fusion): what became of the fixes and the
+// graph's T_enu_world (docs/mapping.md).
+nlohmann::ordered_json gnssFusionJson(const mapping::GnssFusionReport& r) {
+  nlohmann::ordered_json j = {{"fixes", r.total},     {"gated", r.gated},
+                              {"outside_keyframes", r.outside}, {"waiting", r.waiting},
+                              {"used", r.used},       {"down_weighted", r.down_weighted}};
+  if (r.enu_origin)
+    j["enu_origin"] = {{"latitude_deg", r.enu_origin->latitude_deg},
+                       {"longitude_deg", r.enu_origin->longitude_deg},
+                       {"height_ellipsoid_m", r.enu_origin->height_m}};
+  if (r.T_enu_world) {
+    const Eigen::Matrix4d T = r.T_enu_world->matrix();
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    for (int i = 0; i < 4; ++i) rows.push_back({T(i, 0), T(i, 1), T(i, 2), T(i, 3)});
+    j["T_enu_world"] = rows;
+    j["yaw_enu_world_deg"] = std::atan2(T(1, 0), T(0, 0)) * 57.29577951308232;
+  }
+  return j;
+}
+
 void writeSummary(const std::filesystem::path& path, const RunSummary& s,
-                  const std::filesystem::path& recording) {
+                  const std::filesystem::path& recording,
+                  const std::optional<mapping::GnssFusionReport>& gnss_fusion) {
   nlohmann::ordered_json j = {
       {"recording", recording.string()},
       {"scans", s.scans},
@@ -114,6 +137,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
     }
     j["georef"] = georef;
   }
+  if (gnss_fusion) j["gnss_fusion"] = gnssFusionJson(*gnss_fusion);
   openOutput(path) << j.dump(2) << "\n";
 }
 
@@ -260,6 +284,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
     }
     if (const auto* fix = std::get_if<GnssFix>(&event)) {
       gnss.fixes.push_back(*fix);
+      if (config.mapping.gnss_fusion) mapping_thread.addGnssFix(*fix);
       if (!online_georef) online_georef.emplace(georef::settingsFrom(config.georef));
       online_georef->addFix(*fix);
       return false;
@@ -359,7 +384,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       summary.wall_time_s > 0.0 ? summary.duration_s / summary.wall_time_s : 0.0;
   summary.peak_memory_mb = peakMemoryMb();
   summary.initialization = odometry.initializationNote();
-  writeSummary(options.out_dir / "summary.json", summary, recording_path);
+  writeSummary(options.out_dir / "summary.json", summary, recording_path, mapper.gnssReport());
   return summary;
 }
 
