@@ -3,14 +3,19 @@
 #include <fmt/format.h>
 
 #include <stdexcept>
+#include <utility>
 
 #include "taiga/core/log.hpp"
 
 namespace taiga::mapping {
 
 Mapper::Mapper(const MappingConfig& config, const OdometryConfig& odometry,
-               const KeyframeStore& store)
-    : config_(config), odometry_(odometry), store_(store), graph_(config) {
+               const KeyframeStore& store, LoopVerifier verify_loop)
+    : config_(config),
+      odometry_(odometry),
+      store_(store),
+      verify_loop_(std::move(verify_loop)),
+      graph_(config) {
   if (config.gnss_fusion) gnss_.emplace(config);
 }
 
@@ -45,7 +50,7 @@ void Mapper::tryLoopClosure(std::size_t current, double t_s) {
   if (graph_.hasUnsolvedFactors()) graph_.optimize();
   last_attempt_s_ = t_s;
   LoopRecord record{.t_s = t_s,
-                    .attempt = verifyLoop(graph_, store_, current, *candidate, config_, odometry_)};
+                    .attempt = verify_loop_(graph_, store_, current, *candidate, config_, odometry_)};
   if (record.attempt.accepted) {
     record.chi2 = graph_.addLoopIfConsistent(record.attempt.loop, config_.loop_max_chi2);
     if (record.chi2 <= config_.loop_max_chi2) {

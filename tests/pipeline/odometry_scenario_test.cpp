@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -19,6 +20,8 @@
 #include "taiga/io/recording.hpp"
 #include "taiga/io/rosbag.hpp"
 #include "taiga/io/trajectory_io.hpp"
+#include "taiga/mapping/keyframe_store.hpp"
+#include "taiga/mapping/mapper.hpp"
 #include "taiga/pipeline/run.hpp"
 #include "taiga/sim/simulator.hpp"
 
@@ -78,6 +81,87 @@ ScenarioRun simulateAndRun(const std::string& scenario_name, double duration_s, 
   ::testing::Test::RecordProperty("loop_closures", std::to_string(run.summary.loop_closures));
   ::testing::Test::RecordProperty("path_m", std::to_string(run.summary.path_length_m));
   return run;
+}
+
+// The mapping graph built again over a finished run's keyframes (their times from the store,
+// their odometry poses from trajectory_odometry.tum), with `verify_loop` checking the loops.
+struct MappingReplay {
+  std::vector<lie::SE3> poses;
+  std::vector<mapping::LoopRecord> attempts;
+};
+MappingReplay replayMapping(const std::filesystem::path& run_dir, const SystemConfig& config,
+                            const mapping::LoopVerifier& verify_loop) {
+  const mapping::KeyframeStore store = mapping::KeyframeStore::open(
+      run_dir / "keyframes", {.registration_voxel_m = config.odometry.voxel_size_m});
+  const Trajectory odometry = io::readTum(run_dir / "trajectory_odometry.tum");
+  mapping::Mapper mapper(config.mapping, config.odometry, store, verify_loop);
+  for (std::uint64_t id = 0; id < store.size(); ++id) {
+    const double t_s = store.info(id).t_s;
+    mapper.addKeyframe(id, t_s, odometry.poseAt(t_s));
+  }
+  mapper.finish();
+  return {mapper.graph().poses(), mapper.loopAttempts()};
+}
+
+double largestDifference_m(const std::vector<lie::SE3>& a, const std::vector<lie::SE3>& b) {
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    largest = std::max(largest, (a[i].translation() - b[i].translation()).norm());
+  return largest;
+}
+
+// Issue 7: a false loop does not corrupt the map. The first loop that verifies is replaced by a
+// wrong one that registration accepted (1.5 m sideways and 3 deg off, as look-alike stems can
+// give); the chi^2 consistency check must refuse it, leaving the map exactly as if that attempt
+// had failed. With the check off, the same injection moves the map: the test can tell.
+void expectAFalseLoopIsRefused(const std::filesystem::path& run_dir) {
+  SystemConfig config;
+  io::readConfigYaml(run_dir.parent_path() / "recording" / "rig.yaml", config);
+  enum class Tamper { kDrop, kFalsify };
+  bool tampered = false;
+  const auto tamperFirstVerifiedLoop = [&](Tamper tamper) -> mapping::LoopVerifier {
+    tampered = false;
+    return [&, tamper](const mapping::PoseGraph& graph, const mapping::KeyframeStore& store,
+                       std::size_t current, const mapping::LoopCandidate& candidate,
+                       const MappingConfig& mapping_config, const OdometryConfig& odometry) {
+      mapping::LoopAttempt attempt =
+          mapping::verifyLoop(graph, store, current, candidate, mapping_config, odometry);
+      if (!attempt.accepted || tampered) return attempt;
+      tampered = true;
+      if (tamper == Tamper::kDrop) {
+        attempt.accepted = false;
+        attempt.note = "dropped by the test";
+      } else {
+        attempt.loop.T_from_to =
+            attempt.loop.T_from_to *
+            lie::SE3(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.0524), Eigen::Vector3d(0.0, 1.5, 0.0));
+      }
+      return attempt;
+    };
+  };
+  const MappingReplay dropped = replayMapping(run_dir, config, tamperFirstVerifiedLoop(Tamper::kDrop));
+  ASSERT_TRUE(tampered);
+  const MappingReplay guarded =
+      replayMapping(run_dir, config, tamperFirstVerifiedLoop(Tamper::kFalsify));
+  ASSERT_TRUE(tampered);
+  EXPECT_TRUE(std::any_of(guarded.attempts.begin(), guarded.attempts.end(),
+                          [](const mapping::LoopRecord& r) {
+                            return r.attempt.note.find("inconsistent") != std::string::npos;
+                          }))
+      << "the false loop was not refused";
+  const double guarded_m = largestDifference_m(guarded.poses, dropped.poses);
+  ::testing::Test::RecordProperty("false_loop_map_change_m", std::to_string(guarded_m));
+  EXPECT_LT(guarded_m, 0.001);
+
+  config.mapping.loop_max_chi2 = 1e12;  // the consistency check off
+  const MappingReplay unguarded_dropped =
+      replayMapping(run_dir, config, tamperFirstVerifiedLoop(Tamper::kDrop));
+  const MappingReplay unguarded =
+      replayMapping(run_dir, config, tamperFirstVerifiedLoop(Tamper::kFalsify));
+  ASSERT_TRUE(tampered);
+  const double unguarded_m = largestDifference_m(unguarded.poses, unguarded_dropped.poses);
+  ::testing::Test::RecordProperty("false_loop_unguarded_map_change_m", std::to_string(unguarded_m));
+  EXPECT_GT(unguarded_m, 0.3);
 }
 
 void expectEveryScanUsed(const RunSummary& s) {
@@ -180,6 +264,7 @@ TEST(OdometryScenario, HandheldLoopOfThreeMinutes) {
   EXPECT_LT(run.evaluation.ape.translation_m.rmse, run.odometry_evaluation.ape.translation_m.rmse);
   EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.07);
   EXPECT_LT(run.map_sharpness.rms_m, 0.04);
+  expectAFalseLoopIsRefused(dir.path() / "run");
 }
 
 // Issue 6: no divergence and ATE <= 15 cm through vibration bursts and long stops. The crane's

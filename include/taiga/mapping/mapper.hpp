@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -32,10 +33,17 @@ struct LoopRecord {
   double chi2 = 0.0;  ///< cost the loop added, as chi^2 (0 when it did not get that far)
 };
 
+/// Checks a loop candidate: loop_closure.hpp's verifyLoop, or a stand-in that injects false loops
+/// in tests.
+using LoopVerifier = std::function<LoopAttempt(
+    const PoseGraph& graph, const KeyframeStore& store, std::size_t current,
+    const LoopCandidate& candidate, const MappingConfig& config, const OdometryConfig& odometry)>;
+
 class Mapper {
  public:
   /// Reads the keyframes' registration clouds from `store` (which must outlive the mapper).
-  Mapper(const MappingConfig& config, const OdometryConfig& odometry, const KeyframeStore& store);
+  Mapper(const MappingConfig& config, const OdometryConfig& odometry, const KeyframeStore& store,
+         LoopVerifier verify_loop = verifyLoop);
 
   /// Keyframe `id` of the store (ids in order, from 0) at its odometry pose.
   void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
@@ -60,6 +68,7 @@ class Mapper {
   MappingConfig config_;
   OdometryConfig odometry_;
   const KeyframeStore& store_;
+  LoopVerifier verify_loop_;
   PoseGraph graph_;
   std::vector<double> keyframe_times_s_;
   std::optional<GnssFusion> gnss_;
