@@ -61,8 +61,7 @@ void GnssFusion::attach(const georef::LocalFix& fix, const PoseGraph& graph,
                       .covariance_enu_m2 = fix.covariance_enu_m2,
                       .huber_sigmas = config_.gnss_huber_sigmas,
                       .weight = 1.0 / correlationFactor(dt_s, config_.gnss_correlation_time_s)},
-      .t_s = fix.t_s,
-      .p_world = graph.pose(nearest) * d_body};
+      .t_s = fix.t_s};
   attached_.push_back(attached);
 }
 
@@ -94,12 +93,8 @@ bool GnssFusion::afterKeyframe(PoseGraph& graph, const std::vector<double>& keyf
 
 void GnssFusion::tryStart(PoseGraph& graph) {
   if (attached_.size() < static_cast<std::size_t>(config_.gnss_min_fixes)) return;
-  double spread_m = 0.0;
-  for (const Attached& attached : attached_)
-    spread_m = std::max(spread_m,
-                        (attached.p_world - attached_.front().p_world).head<2>().norm());
-  if (spread_m < config_.gnss_min_spread_m) return;
-
+  // Antenna positions at the current poses (the world frame may have been levelled since the
+  // fixes were attached).
   std::vector<georef::AssociatedFix> pairs;
   for (const Attached& attached : attached_) {
     const GnssObservation& o = attached.observation;
@@ -107,8 +102,13 @@ void GnssFusion::tryStart(PoseGraph& graph) {
                              .p_enu = o.p_enu,
                              .covariance_enu_m2 = o.covariance_enu_m2},
                      .T_world_body = graph.pose(o.keyframe),
-                     .p_world = attached.p_world});
+                     .p_world = graph.pose(o.keyframe) * o.d_body});
   }
+  double spread_m = 0.0;
+  for (const georef::AssociatedFix& pair : pairs)
+    spread_m = std::max(spread_m, (pair.p_world - pairs.front().p_world).head<2>().norm());
+  if (spread_m < config_.gnss_min_spread_m) return;
+
   georef::FitOptions options;
   options.error_correlation_time_s = config_.gnss_correlation_time_s;
   try {

@@ -309,6 +309,27 @@ TEST(GnssFusion, MappingThreadGivesTheInlineResultBitForBit) {
   EXPECT_LT(ateAfterAlignment(inline_poses, truth), 0.95 * ateAfterAlignment(odometry, truth));
 }
 
+// The odometry re-levels its world frame (PoseGraph::changeWorldFrame): T_enu_world follows, so
+// the georeferenced map stays where it was, before and after solving again.
+TEST(GnssFusion, AWorldFrameChangeKeepsTheGeoreferencedMap) {
+  const std::vector<lie::SE3> truth = trueRectangle();
+  const Fused fused = fuse(fusionConfig(), driftingOdometry(truth), fixesFor(truth, {}, 6));
+  PoseGraph changed = fused.graph;
+  const lie::SE3 T_new_old(lie::SO3::fromRollPitchYaw(0, 0, 0.4), {3, -2, 0.5});
+  changed.changeWorldFrame(T_new_old);
+  auto worstGeoreferencedChange = [&](const PoseGraph& graph) {
+    double worst = 0.0;
+    for (std::size_t k = 0; k < graph.size(); ++k)
+      worst = std::max(worst, (*graph.enuWorld() * graph.pose(k).translation() -
+                               *fused.graph.enuWorld() * fused.graph.pose(k).translation())
+                                  .norm());
+    return worst;
+  };
+  EXPECT_LT(worstGeoreferencedChange(changed), 1e-9);
+  changed.optimize();
+  EXPECT_LT(worstGeoreferencedChange(changed), 1e-4);
+}
+
 TEST(GnssFusion, OffByDefault) {
   const test::TempDir dir;
   const KeyframeStore store = KeyframeStore::create(dir.path());

@@ -67,7 +67,6 @@ class GnssFusion {
   struct Attached {
     GnssObservation observation;
     double t_s;
-    Eigen::Vector3d p_world;  ///< at attaching, for the spread and the initial fit
   };
   void attach(const georef::LocalFix& fix, const PoseGraph& graph,
               const std::vector<double>& keyframe_times_s);
