@@ -30,6 +30,10 @@ function(taiga_add_test module name)
   target_link_libraries(${name} PRIVATE taiga::${module} ${ARG_DEPENDS} GTest::gtest_main
                                         GTest::gmock)
   taiga_set_warnings(${name})
-  gtest_discover_tests(${name} PROPERTIES LABELS "${module};${ARG_LABELS}"
+  # One label joined with '/' (e.g. "pipeline/long"): gtest_discover_tests keeps only the first
+  # element of a list in PROPERTIES. ctest -L/-LE take regular expressions, so -L pipeline,
+  # -L long and -LE long all see it.
+  string(JOIN "/" label ${module} ${ARG_LABELS})
+  gtest_discover_tests(${name} PROPERTIES LABELS ${label}
                        WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} DISCOVERY_TIMEOUT 60)
 endfunction()
