@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "taiga/core/errors.hpp"
@@ -97,6 +98,23 @@ lie::SE3 rigidFit(const std::vector<AssociatedFix>& pairs, const std::vector<boo
 
 Matrix6d inverseNormal(const Matrix6d& H) {
   return H.ldlt().solve(Matrix6d::Identity());
+}
+
+void gaussNewton(const std::function<NormalEquations(const lie::SE3&)>& linearize, double dof,
+                 const FitOptions& options, GeorefFit& fit) {
+  fit.converged = false;
+  NormalEquations normal = linearize(fit.T_enu_world);
+  for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
+    const Vector6d delta = -normal.H.ldlt().solve(normal.b);
+    fit.T_enu_world = applyUpdate(fit.T_enu_world, delta);
+    normal = linearize(fit.T_enu_world);
+    if (delta.norm() < options.convergence_step) {
+      fit.converged = true;
+      break;
+    }
+  }
+  fit.iterations = std::min(fit.iterations, options.max_iterations);
+  fit.covariance = std::max(1.0, normal.chi2 / dof) * inverseNormal(normal.H);
 }
 
 }  // namespace taiga::georef::detail

@@ -21,14 +21,8 @@ GeorefFit fitPf3(const std::vector<AssociatedFix>& pairs, const FitOptions& opti
       options.trajectory_position_sigma_m * options.trajectory_position_sigma_m *
       Eigen::Matrix3d::Identity();
 
-  // One linearization at T: the normal matrix, gradient and weighted squared residual sum.
-  struct Normal {
-    Matrix6d H = Matrix6d::Zero();
-    Vector6d b = Vector6d::Zero();
-    double chi2 = 0.0;
-  };
-  const auto linearize = [&](const lie::SE3& T) -> Normal {
-    Normal normal;
+  const auto linearize = [&](const lie::SE3& T) -> detail::NormalEquations {
+    detail::NormalEquations normal;
     const Eigen::Matrix3d R = T.rotation().matrix();
     for (const AssociatedFix& pair : pairs) {
       Matrix36d J;
@@ -42,20 +36,7 @@ GeorefFit fitPf3(const std::vector<AssociatedFix>& pairs, const FitOptions& opti
     return normal;
   };
 
-  fit.converged = false;
-  Normal normal = linearize(fit.T_enu_world);
-  for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
-    const Vector6d delta = -normal.H.ldlt().solve(normal.b);
-    fit.T_enu_world = applyUpdate(fit.T_enu_world, delta);
-    normal = linearize(fit.T_enu_world);
-    if (delta.norm() < options.convergence_step) {
-      fit.converged = true;
-      break;
-    }
-  }
-  fit.iterations = std::min(fit.iterations, options.max_iterations);
-  const double dof = 3.0 * static_cast<double>(pairs.size()) - 6.0;
-  fit.covariance = std::max(1.0, normal.chi2 / dof) * detail::inverseNormal(normal.H);
+  detail::gaussNewton(linearize, 3.0 * static_cast<double>(pairs.size()) - 6.0, options, fit);
   detail::finishFit(pairs, options, fit);
   return fit;
 }

@@ -53,13 +53,8 @@ GeorefFit fitPf6(const std::vector<AssociatedFix>& pairs,
   sigma_traj.bottomRightCorner<3, 3>().diagonal().setConstant(
       options.trajectory_rotation_sigma_rad * options.trajectory_rotation_sigma_rad);
 
-  struct Normal {
-    Matrix6d H = Matrix6d::Zero();
-    Vector6d b = Vector6d::Zero();
-    double chi2 = 0.0;
-  };
-  const auto linearize = [&](const lie::SE3& T) -> Normal {
-    Normal normal;
+  const auto linearize = [&](const lie::SE3& T) -> detail::NormalEquations {
+    detail::NormalEquations normal;
     for (std::size_t i = 0; i < oriented.size(); ++i) {
       const lie::SE3 T_world_antenna(oriented[i].T_world_body.rotation(), oriented[i].p_world);
       Matrix6d J;
@@ -92,20 +87,7 @@ GeorefFit fitPf6(const std::vector<AssociatedFix>& pairs,
     for (const AssociatedFix& pair : oriented) offset += pair.fix.p_enu - R0 * pair.p_world;
     fit.T_enu_world = lie::SE3(R0, offset / static_cast<double>(oriented.size()));
   }
-  fit.converged = false;
-  Normal normal = linearize(fit.T_enu_world);
-  for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
-    const Vector6d delta = -normal.H.ldlt().solve(normal.b);
-    fit.T_enu_world = applyUpdate(fit.T_enu_world, delta);
-    normal = linearize(fit.T_enu_world);
-    if (delta.norm() < options.convergence_step) {
-      fit.converged = true;
-      break;
-    }
-  }
-  fit.iterations = std::min(fit.iterations, options.max_iterations);
-  const double dof = 6.0 * static_cast<double>(oriented.size()) - 6.0;
-  fit.covariance = std::max(1.0, normal.chi2 / dof) * detail::inverseNormal(normal.H);
+  detail::gaussNewton(linearize, 6.0 * static_cast<double>(oriented.size()) - 6.0, options, fit);
   detail::finishFit(pairs, options, fit);
   return fit;
 }
