@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <list>
+#include <unordered_map>
+
 #include "taiga/core/errors.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/mapping/keyframe_file.hpp"
@@ -17,20 +20,73 @@ std::shared_ptr<const PointCloud> registrationCopy(const PointCloud& cloud_in_bo
   if (voxel_m <= 0.0) return std::make_shared<const PointCloud>();
   const PointCloud filtered = preprocess::voxelFilter(cloud_in_body, voxel_m);
   // Registration needs positions only. A fresh vector of the exact size: the filter's own keeps
-  // the capacity it grew to (up to twice its size), and a copy stays in RAM per keyframe.
+  // the capacity it grew to (up to twice its size), and up to registration_cache_keyframes
+  // copies stay in RAM.
   auto positions_only = std::make_shared<PointCloud>();
   positions_only->positions.assign(filtered.positions.begin(), filtered.positions.end());
   return positions_only;
 }
 
+// The registration copies kept in RAM: at most `capacity`, the least recently used evicted, so
+// memory stays bounded however many keyframes the store holds. Not thread-safe by itself.
+class RegistrationCache {
+ public:
+  explicit RegistrationCache(std::size_t capacity) : capacity_(capacity) {}
+
+  /// The cached copy of keyframe `id` (now the most recently used), or null.
+  std::shared_ptr<const PointCloud> find(std::uint64_t id) {
+    const auto found = entries_.find(id);
+    if (found == entries_.end()) return nullptr;
+    ids_most_recent_first_.splice(ids_most_recent_first_.begin(), ids_most_recent_first_,
+                                  found->second.position);
+    return found->second.copy;
+  }
+
+  /// Caches `copy` as the most recently used, evicting the least recently used beyond capacity,
+  /// and returns the cached copy (the one already there when another thread cached it first).
+  /// Callers holding an evicted copy keep it alive (shared ownership).
+  std::shared_ptr<const PointCloud> insert(std::uint64_t id,
+                                           std::shared_ptr<const PointCloud> copy) {
+    if (capacity_ == 0) return copy;
+    if (std::shared_ptr<const PointCloud> cached = find(id)) return cached;
+    ids_most_recent_first_.push_front(id);
+    entries_.emplace(id, Entry{copy, ids_most_recent_first_.begin()});
+    while (entries_.size() > capacity_) {
+      entries_.erase(ids_most_recent_first_.back());
+      ids_most_recent_first_.pop_back();
+    }
+    return copy;
+  }
+
+  std::size_t size() const { return entries_.size(); }
+
+ private:
+  struct Entry {
+    std::shared_ptr<const PointCloud> copy;
+    std::list<std::uint64_t>::iterator position;  // in ids_most_recent_first_
+  };
+  std::size_t capacity_;
+  std::list<std::uint64_t> ids_most_recent_first_;
+  std::unordered_map<std::uint64_t, Entry> entries_;
+};
+
 }  // namespace
 
 struct KeyframeStore::Impl {
+  explicit Impl(const std::filesystem::path& directory, const KeyframeStoreOptions& store_options)
+      : dir(directory),
+        options(store_options),
+        registration_cache(store_options.registration_cache_keyframes) {}
+
   std::filesystem::path dir;
   KeyframeStoreOptions options;
-  mutable std::mutex mutex;
+  mutable std::mutex mutex;  // guards infos
   std::vector<KeyframeInfo> infos;
-  std::vector<std::shared_ptr<const PointCloud>> registration_clouds;
+  // Its own lock, never held together with `mutex`: a cache miss reads a file without either.
+  mutable std::mutex cache_mutex;  // guards registration_cache and the counters
+  mutable RegistrationCache registration_cache;
+  mutable std::uint64_t registration_cache_hits = 0;
+  mutable std::uint64_t registration_copies_rebuilt = 0;
 
   const KeyframeInfo& at(std::uint64_t id) const {
     if (id >= infos.size())
@@ -57,10 +113,7 @@ KeyframeStore KeyframeStore::create(const std::filesystem::path& dir,
     if (entry.path().extension() == ".tkf" || entry.path().filename() == kPosesFile)
       std::filesystem::remove(entry.path());
   }
-  auto impl = std::make_unique<Impl>();
-  impl->dir = dir;
-  impl->options = options;
-  return KeyframeStore(std::move(impl));
+  return KeyframeStore(std::make_unique<Impl>(dir, options));
 }
 
 KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStoreOptions options) {
@@ -69,10 +122,8 @@ KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStor
     throw InputError(fmt::format("{}: missing: not a keyframe directory of taiga run",
                                  poses_path.string()));
   const Trajectory poses = io::readTum(poses_path);
-  auto impl = std::make_unique<Impl>();
-  impl->dir = dir;
-  impl->options = options;
-  KeyframeStore store(std::move(impl));
+  // Only the headers: the registration copies are rebuilt from the files when first asked for.
+  KeyframeStore store(std::make_unique<Impl>(dir, options));
   for (std::size_t id = 0; id < poses.size(); ++id) {
     const std::filesystem::path path = store.keyframePath(id);
     if (!std::filesystem::exists(path))
@@ -81,7 +132,6 @@ KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStor
     KeyframeInfo info;
     info.id = id;
     info.T_world_body = poses[id].pose;
-    std::shared_ptr<const PointCloud> registration;
     const KeyframeFileHeader header = readKeyframeHeader(path);
     if (header.id != id || header.t_s != poses[id].t_s) {
       throw InputError(fmt::format(
@@ -90,14 +140,7 @@ KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStor
     }
     info.t_s = header.t_s;
     info.point_count = header.point_count;
-    if (options.registration_voxel_m > 0.0) {
-      registration =
-          registrationCopy(readKeyframeFile(path).cloud_in_body, options.registration_voxel_m);
-    } else {
-      registration = std::make_shared<const PointCloud>();
-    }
     store.impl_->infos.push_back(info);
-    store.impl_->registration_clouds.push_back(std::move(registration));
   }
   return store;
 }
@@ -116,11 +159,16 @@ std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_world_body,
   writeKeyframeFile(keyframePath(id), id, t_s, cloud_in_body);
   KeyframeInfo info{.id = id, .t_s = t_s, .T_world_body = T_world_body,
                     .point_count = cloud_in_body.size()};
-  std::shared_ptr<const PointCloud> registration =
-      registrationCopy(cloud_in_body, impl_->options.registration_voxel_m);
+  if (impl_->options.registration_voxel_m > 0.0) {
+    // The newest keyframe is the one loop closure asks for next: cache its copy now, from the
+    // scan at hand, rather than read the file back.
+    std::shared_ptr<const PointCloud> registration =
+        registrationCopy(cloud_in_body, impl_->options.registration_voxel_m);
+    const std::lock_guard cache_lock(impl_->cache_mutex);
+    impl_->registration_cache.insert(id, std::move(registration));
+  }
   const std::lock_guard lock(impl_->mutex);
   impl_->infos.push_back(info);
-  impl_->registration_clouds.push_back(std::move(registration));
   return id;
 }
 
@@ -147,9 +195,30 @@ PointCloud KeyframeStore::load(std::uint64_t id) const {
 }
 
 std::shared_ptr<const PointCloud> KeyframeStore::registrationCloud(std::uint64_t id) const {
-  const std::lock_guard lock(impl_->mutex);
-  impl_->at(id);
-  return impl_->registration_clouds[id];
+  info(id);  // OutOfRangeError for an unknown id
+  const double voxel_m = impl_->options.registration_voxel_m;
+  if (voxel_m <= 0.0) return std::make_shared<const PointCloud>();
+  {
+    const std::lock_guard cache_lock(impl_->cache_mutex);
+    if (std::shared_ptr<const PointCloud> cached = impl_->registration_cache.find(id)) {
+      ++impl_->registration_cache_hits;
+      return cached;
+    }
+  }
+  // Rebuilt outside the lock, so that readers of cached keyframes go on. The file holds the scan
+  // add() filtered, bit for bit, and the filter is deterministic: the same copy as add() made.
+  // Two threads missing the same keyframe both rebuild it; either result is the same.
+  std::shared_ptr<const PointCloud> rebuilt = registrationCopy(load(id), voxel_m);
+  const std::lock_guard cache_lock(impl_->cache_mutex);
+  ++impl_->registration_copies_rebuilt;
+  return impl_->registration_cache.insert(id, std::move(rebuilt));
+}
+
+RegistrationCacheStatistics KeyframeStore::registrationCacheStatistics() const {
+  const std::lock_guard cache_lock(impl_->cache_mutex);
+  return {.cached_keyframes = impl_->registration_cache.size(),
+          .hits = impl_->registration_cache_hits,
+          .rebuilt = impl_->registration_copies_rebuilt};
 }
 
 KeyframeInfo KeyframeStore::info(std::uint64_t id) const {

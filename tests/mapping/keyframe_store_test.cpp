@@ -1,5 +1,6 @@
-// The disk-backed keyframe store: scans read back bit for bit, metadata and registration clouds
-// in RAM, poses saved and reopened, and corrupt files reported with their name.
+// The disk-backed keyframe store: scans read back bit for bit, metadata in RAM, registration
+// copies in a bounded least-recently-used cache and rebuilt from disk bit for bit, poses saved
+// and reopened, and corrupt files reported with their name.
 #include "taiga/mapping/keyframe_store.hpp"
 
 #include <gmock/gmock.h>
@@ -8,11 +9,15 @@
 #include <fstream>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <atomic>
 #include <random>
+#include <thread>
 
 #include "../support/temp_dir.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/mapping/keyframe_file.hpp"
+#include "taiga/preprocess/voxel_filter.hpp"
 
 namespace taiga::mapping {
 namespace {
@@ -86,6 +91,152 @@ TEST(KeyframeStore, KeepsAVoxelFilteredCopyForRegistration) {
   ASSERT_EQ(registration->size(), 2u);
   EXPECT_NEAR(registration->positions[0].x(), 0.135, 1e-12);  // the voxel's centroid
   EXPECT_EQ(store.load(0).size(), 9u);                         // the full scan stays on disk
+}
+
+// The registration copy add() makes: the scan's 0.4 m voxel centroids, positions only.
+std::vector<Eigen::Vector3d> expectedRegistrationPositions(const PointCloud& scan_in_body) {
+  return preprocess::voxelFilter(scan_in_body, 0.4).positions;
+}
+
+// Scans whose registration copies differ from one keyframe to the next.
+std::vector<PointCloud> distinctScans(std::size_t count) {
+  std::vector<PointCloud> scans;
+  for (std::size_t k = 0; k < count; ++k)
+    scans.push_back(randomScan(3000 + 37 * k, 100.0 + static_cast<double>(k),
+                               static_cast<unsigned>(100 + k)));
+  return scans;
+}
+
+TEST(KeyframeStore, ACacheSmallerThanTheStoreGivesTheSameCopiesBitForBitInAnyOrder) {
+  test::TempDir dir;
+  constexpr std::size_t kKeyframes = 12;
+  constexpr std::size_t kCapacity = 3;
+  const std::vector<PointCloud> scans = distinctScans(kKeyframes);
+  // The reference: a cache holding every copy, as the store kept them all before the cache.
+  KeyframeStore uncached =
+      KeyframeStore::create(dir.path() / "uncached",
+                            {.registration_voxel_m = 0.4, .registration_cache_keyframes = kKeyframes});
+  KeyframeStore cached = KeyframeStore::create(
+      dir.path() / "cached", {.registration_voxel_m = 0.4, .registration_cache_keyframes = kCapacity});
+  for (std::size_t k = 0; k < kKeyframes; ++k) {
+    const double t_s = 100.0 + static_cast<double>(k);
+    uncached.add(t_s, somePose(static_cast<double>(k)), scans[k]);
+    cached.add(t_s, somePose(static_cast<double>(k)), scans[k]);
+    EXPECT_LE(cached.registrationCacheStatistics().cached_keyframes, kCapacity);
+  }
+  EXPECT_EQ(cached.registrationCacheStatistics().cached_keyframes, kCapacity);
+  EXPECT_EQ(uncached.registrationCacheStatistics().cached_keyframes, kKeyframes);
+
+  // Every id several times, in a random order: hits and rebuilds from disk mixed.
+  std::vector<std::uint64_t> order;
+  for (int pass = 0; pass < 4; ++pass)
+    for (std::uint64_t id = 0; id < kKeyframes; ++id) order.push_back(id);
+  std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  for (const std::uint64_t id : order) {
+    const std::shared_ptr<const PointCloud> copy = cached.registrationCloud(id);
+    const std::shared_ptr<const PointCloud> reference = uncached.registrationCloud(id);
+    ASSERT_EQ(copy->size(), reference->size()) << "keyframe " << id;
+    EXPECT_EQ(copy->positions, reference->positions) << "keyframe " << id;  // bit for bit
+    EXPECT_EQ(copy->positions, expectedRegistrationPositions(scans[id])) << "keyframe " << id;
+    // Loop closure registers positions only: no other channel is kept.
+    EXPECT_TRUE(copy->times_s.empty() && copy->intensities.empty() && copy->rings.empty() &&
+                copy->columns.empty());
+    EXPECT_LE(cached.registrationCacheStatistics().cached_keyframes, kCapacity);
+  }
+  const RegistrationCacheStatistics statistics = cached.registrationCacheStatistics();
+  EXPECT_GT(statistics.rebuilt, 0u);  // the copies did come from disk
+  EXPECT_GT(statistics.hits, 0u);
+  EXPECT_EQ(statistics.hits + statistics.rebuilt, order.size());
+  EXPECT_EQ(uncached.registrationCacheStatistics().rebuilt, 0u);
+  EXPECT_THROW(cached.registrationCloud(kKeyframes), OutOfRangeError);
+}
+
+TEST(KeyframeStore, TheLeastRecentlyUsedCopyIsEvictedAndACopyHandedOutOutlivesEviction) {
+  test::TempDir dir;
+  const std::vector<PointCloud> scans = distinctScans(4);
+  KeyframeStore store =
+      KeyframeStore::create(dir.path(), {.registration_voxel_m = 0.4, .registration_cache_keyframes = 2});
+  store.add(100.0, somePose(0), scans[0]);
+  store.add(101.0, somePose(1), scans[1]);  // cached: 1, 0
+  const std::shared_ptr<const PointCloud> copy_0 = store.registrationCloud(0);  // cached: 0, 1
+  EXPECT_EQ(store.registrationCacheStatistics().hits, 1u);
+  store.add(102.0, somePose(2), scans[2]);  // cached: 2, 0; 1 evicted
+  store.registrationCloud(0);
+  EXPECT_EQ(store.registrationCacheStatistics().rebuilt, 0u);
+  store.registrationCloud(1);  // rebuilt; cached: 1, 0; 2 evicted
+  EXPECT_EQ(store.registrationCacheStatistics().rebuilt, 1u);
+  store.add(103.0, somePose(3), scans[3]);  // cached: 3, 1; 0 evicted
+  store.registrationCloud(2);               // rebuilt; cached: 2, 3
+  EXPECT_EQ(store.registrationCacheStatistics().rebuilt, 2u);
+  EXPECT_EQ(store.registrationCacheStatistics().cached_keyframes, 2u);
+  // Keyframe 0's copy is no longer cached, but the one handed out is intact.
+  EXPECT_EQ(copy_0->positions, expectedRegistrationPositions(scans[0]));
+  const std::shared_ptr<const PointCloud> copy_0_again = store.registrationCloud(0);
+  EXPECT_EQ(store.registrationCacheStatistics().rebuilt, 3u);
+  EXPECT_NE(copy_0_again, copy_0);
+  EXPECT_EQ(copy_0_again->positions, copy_0->positions);
+
+  // Capacity 0: nothing stays in RAM, every copy comes from disk.
+  KeyframeStore uncached = KeyframeStore::create(
+      dir.path() / "none", {.registration_voxel_m = 0.4, .registration_cache_keyframes = 0});
+  uncached.add(100.0, somePose(0), scans[0]);
+  EXPECT_EQ(uncached.registrationCacheStatistics().cached_keyframes, 0u);
+  EXPECT_EQ(uncached.registrationCloud(0)->positions, expectedRegistrationPositions(scans[0]));
+  EXPECT_EQ(uncached.registrationCacheStatistics().rebuilt, 1u);
+}
+
+TEST(KeyframeStore, OpenReadsNoScanAndRebuildsCopiesWhenAsked) {
+  test::TempDir dir;
+  const std::vector<PointCloud> scans = distinctScans(5);
+  {
+    KeyframeStore store = KeyframeStore::create(dir.path(), {.registration_voxel_m = 0.4});
+    for (std::size_t k = 0; k < scans.size(); ++k)
+      store.add(100.0 + static_cast<double>(k), somePose(static_cast<double>(k)), scans[k]);
+    store.writePoses();
+  }
+  const KeyframeStore reopened = KeyframeStore::open(
+      dir.path(), {.registration_voxel_m = 0.4, .registration_cache_keyframes = 2});
+  EXPECT_EQ(reopened.registrationCacheStatistics().cached_keyframes, 0u);
+  EXPECT_EQ(reopened.registrationCacheStatistics().rebuilt, 0u);
+  for (std::uint64_t k : {4u, 0u, 2u, 3u, 0u, 1u, 1u}) {
+    EXPECT_EQ(reopened.registrationCloud(k)->positions, expectedRegistrationPositions(scans[k]));
+    EXPECT_LE(reopened.registrationCacheStatistics().cached_keyframes, 2u);
+  }
+  EXPECT_EQ(reopened.registrationCacheStatistics().rebuilt, 6u);  // 0 again: evicted by 2 and 3
+  EXPECT_EQ(reopened.registrationCacheStatistics().hits, 1u);     // 1 again: still cached
+}
+
+TEST(KeyframeStore, ReadersGetExactCopiesWhileOneThreadAdds) {
+  test::TempDir dir;
+  constexpr std::size_t kKeyframes = 40;
+  const std::vector<PointCloud> scans = distinctScans(kKeyframes);
+  std::vector<std::vector<Eigen::Vector3d>> expected;
+  for (const PointCloud& scan : scans) expected.push_back(expectedRegistrationPositions(scan));
+  KeyframeStore store =
+      KeyframeStore::create(dir.path(), {.registration_voxel_m = 0.4, .registration_cache_keyframes = 4});
+  std::atomic<bool> adding_done = false;
+  std::atomic<int> mismatches = 0;
+  std::atomic<int> reads = 0;
+  auto read_random_keyframes = [&](unsigned seed) {
+    std::mt19937 rng(seed);
+    while (!adding_done || reads < 200) {
+      const std::size_t available = store.size();
+      if (available == 0) continue;
+      const std::uint64_t id = std::uniform_int_distribution<std::uint64_t>(0, available - 1)(rng);
+      if (store.registrationCloud(id)->positions != expected[id]) ++mismatches;
+      if (store.registrationCacheStatistics().cached_keyframes > 4) ++mismatches;
+      ++reads;
+    }
+  };
+  std::thread reader_a(read_random_keyframes, 1u), reader_b(read_random_keyframes, 2u);
+  for (std::size_t k = 0; k < kKeyframes; ++k)
+    store.add(100.0 + static_cast<double>(k), somePose(static_cast<double>(k)), scans[k]);
+  adding_done = true;
+  reader_a.join();
+  reader_b.join();
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GE(reads, 200);
+  EXPECT_LE(store.registrationCacheStatistics().cached_keyframes, 4u);
 }
 
 TEST(KeyframeStore, PosesAreSavedCorrectedAndReopened) {

@@ -3,17 +3,22 @@
 //
 // add() writes the keyframe's full-resolution deskewed scan (body frame) to
 // DIR/NNNNNN.tkf (keyframe_file.hpp) at once and keeps in RAM only what the mapping needs
-// often: time, pose, point count and, when
-// registration_voxel_m > 0, a voxel-filtered copy of the scan for loop closure
-// (registrationCloud()). load() reads the full scan back. The poses are kept in RAM; setPoses()
-// replaces them when the world frame is levelled or the mapping graph corrects them, and
-// writePoses() saves them as DIR/poses.tum (TUM, T_world_body, one line per keyframe in id
-// order), so that `taiga export-map DIR` re-exports a finished run with its final poses.
+// often: time, pose and point count. When registration_voxel_m > 0, registrationCloud() gives a
+// voxel-filtered, positions-only copy of the scan for loop closure; only the
+// registration_cache_keyframes most recently used copies stay in RAM (least recently used
+// evicted), and a copy not cached is rebuilt from the keyframe file with the same deterministic
+// filter, so it is bit for bit the copy add() made. load() reads the full scan back. The poses
+// are kept in RAM; setPoses() replaces them when the world frame is levelled or the mapping
+// graph corrects them, and writePoses() saves them as DIR/poses.tum (TUM, T_world_body, one line
+// per keyframe in id order), so that `taiga export-map DIR` re-exports a finished run with its
+// final poses.
 //
 // Ids are 0, 1, 2, ... in the order of add(). Thread-safe: one thread may add() while others
-// call load(), registrationCloud(), pose() or setPoses().
+// call load(), registrationCloud(), pose() or setPoses(). A registration copy handed out stays
+// valid after the cache evicts it (shared ownership).
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -27,9 +32,21 @@
 namespace taiga::mapping {
 
 struct KeyframeStoreOptions {
-  /// > 0: keep a copy of each scan filtered to this voxel size in RAM (registrationCloud()), m.
-  /// The odometry registers at 0.4 m (thesis 3.1.1). 0: keep nothing but the metadata.
+  /// > 0: registrationCloud() gives a copy of each scan filtered to this voxel size, m. The
+  /// odometry registers at 0.4 m (thesis 3.1.1). 0: no copies, registrationCloud() is empty.
   double registration_voxel_m = 0.0;
+  /// How many registration copies stay in RAM (least recently used evicted; the others are
+  /// rebuilt from disk when asked for). A loop attempt uses the current keyframe's copy and
+  /// 2 x loop_submap_keyframes + 1 around the candidate (21 by default): 64 keeps those and the
+  /// newest keyframes, ~15 MB at 0.4 m. 0: nothing cached, every call reads the file.
+  std::size_t registration_cache_keyframes = 64;
+};
+
+/// What the registration-copy cache holds and has done (tests, benchmarks).
+struct RegistrationCacheStatistics {
+  std::size_t cached_keyframes = 0;  ///< copies in RAM now, <= registration_cache_keyframes
+  std::uint64_t hits = 0;            ///< registrationCloud() calls served from RAM
+  std::uint64_t rebuilt = 0;         ///< copies rebuilt from a keyframe file
 };
 
 /// What stays in RAM per keyframe.
@@ -45,8 +62,8 @@ class KeyframeStore {
   /// A new store in `dir` (created; keyframe files and poses.tum already there are replaced).
   static KeyframeStore create(const std::filesystem::path& dir, KeyframeStoreOptions options = {});
   /// An existing store: poses.tum and the header of every keyframe file it implies (the full
-  /// scans are read only when registration_voxel_m > 0). InputError naming the file when a file
-  /// is missing, corrupt or disagrees with poses.tum.
+  /// scans are read only when asked for, by load() or registrationCloud()). InputError naming
+  /// the file when a file is missing, has the wrong size or disagrees with poses.tum.
   static KeyframeStore open(const std::filesystem::path& dir, KeyframeStoreOptions options = {});
 
   KeyframeStore(KeyframeStore&&) noexcept;
@@ -65,8 +82,11 @@ class KeyframeStore {
 
   /// The full scan of keyframe `id` in the body frame, read from disk (bit for bit as added).
   PointCloud load(std::uint64_t id) const;
-  /// The voxel-filtered scan in the body frame; empty when registration_voxel_m is 0.
+  /// The voxel-filtered scan in the body frame, positions only (no other channel); empty when
+  /// registration_voxel_m is 0. From the cache, or rebuilt from the keyframe file (InputError as
+  /// for load()) and cached.
   std::shared_ptr<const PointCloud> registrationCloud(std::uint64_t id) const;
+  RegistrationCacheStatistics registrationCacheStatistics() const;
 
   KeyframeInfo info(std::uint64_t id) const;
   lie::SE3 pose(std::uint64_t id) const;
