@@ -35,7 +35,9 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   static constexpr std::array<std::string_view, 3> kMethods{"ndt", "d2d", "gicp"};
   v.choice("method", method, kMethods,
            "scan-to-map registration: ndt, d2d (distribution-to-distribution) or gicp");
-  v.field("ndt_resolution_m", ndt_resolution_m, "m, NDT cell size of the local map");
+  v.field("ndt_resolution_m", ndt_resolution_m, "m, NDT cell size of the local map (final pass)");
+  v.field("ndt_coarse_resolution_m", ndt_coarse_resolution_m,
+          "m, NDT cell size of a first, coarser pass (wider basin); 0: one pass");
   static constexpr std::array<std::string_view, 2> kNeighbours{"direct1", "direct7"};
   v.choice("ndt_neighbours", ndt_neighbours, kNeighbours,
            "NDT cells each scan point is scored against: its own (direct1) or also the six face "
@@ -76,11 +78,20 @@ LidarSigmas OdometryConfig::lidarSigmas(double fitness_m2, double inflation) con
   return {lidar_sigma * growth, lidar_sigma * growth, heading_rad * growth};
 }
 
+std::vector<double> OdometryConfig::ndtResolutionsM() const {
+  if (ndt_coarse_resolution_m > ndt_resolution_m) return {ndt_coarse_resolution_m, ndt_resolution_m};
+  return {ndt_resolution_m};
+}
+
 void OdometryConfig::validate() const {
   requireNonNegative("min_range_m", min_range_m, "m");
   requireInRange("max_range_m", max_range_m, min_range_m + 0.1, 1000.0, "m");
   requireInRange("voxel_size_m", voxel_size_m, 0.01, 5.0, "m");
   requireInRange("ndt_resolution_m", ndt_resolution_m, 0.1, 10.0, "m");
+  if (ndt_coarse_resolution_m != 0.0) {
+    requireInRange("ndt_coarse_resolution_m", ndt_coarse_resolution_m, ndt_resolution_m, 10.0,
+                   "m (0: one pass)");
+  }
   requireInRange("local_map_voxel_m", local_map_voxel_m, 0.01, 5.0, "m");
   requireInRange("local_map_keyframes", local_map_keyframes, 1, 1000, "keyframes");
   requirePositive("lidar_sigma", lidar_sigma, "m");

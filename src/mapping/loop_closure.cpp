@@ -54,9 +54,14 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   }
 
   registration::RegistrationConfig registration_config;
-  registration_config.ndt.resolution_m = odometry.ndt_resolution_m;
-  // The guess may be off by the drift since the candidate: a coarse pass widens the basin.
-  registration_config.ndt.coarse_resolutions_m = {3.0 * odometry.ndt_resolution_m};
+  // The odometry's passes, after one at 3x its coarsest cells: the guess may be off by the drift
+  // since the candidate, and a coarser pass widens the basin.
+  const std::vector<double> resolutions_m = odometry.ndtResolutionsM();
+  registration_config.ndt.resolution_m = resolutions_m.back();
+  registration_config.ndt.coarse_resolutions_m = {3.0 * resolutions_m.front()};
+  registration_config.ndt.coarse_resolutions_m.insert(
+      registration_config.ndt.coarse_resolutions_m.end(), resolutions_m.begin(),
+      resolutions_m.end() - 1);
   registration_config.ndt.search = registration::NeighbourSearch::kDirect7;
   const lie::SE3 guess_T_candidate_current = T_candidate_world * graph.pose(current);
   attempt.registration = registration::registerClouds(source->positions, submap_in_candidate,

@@ -50,7 +50,8 @@ LidarInertialOdometry::LidarInertialOdometry(const OdometryConfig& config, const
       rig_(rig),
       gravity_world_(0.0, 0.0, -config.imu.gravity_mps2),
       smoother_({.gravity_world = gravity_world_, .window_states = config.window_states}),
-      local_map_(config.ndt_resolution_m, config.local_map_voxel_m, config.local_map_keyframes,
+      // The IMU predicts within centimetres: the fine cells' basin suffices (setLidarOnly()).
+      local_map_({config.ndt_resolution_m}, config.local_map_voxel_m, config.local_map_keyframes,
                  config.method == "gicp" ? LocalMap::Target::kGicp : LocalMap::Target::kNdt),
       levelled_(config.gravity_alignment_s <= 0.0) {
   const lie::SE3 T_lidar_body = rig_.T_body_lidar.inverse();
@@ -59,6 +60,12 @@ LidarInertialOdometry::LidarInertialOdometry(const OdometryConfig& config, const
 }
 
 LidarInertialOdometry::~LidarInertialOdometry() = default;
+
+void LidarInertialOdometry::setLidarOnly(bool lidar_only) {
+  lidar_only_ = lidar_only;
+  local_map_.setNdtResolutions(lidar_only ? config_.ndtResolutionsM()
+                                          : std::vector<double>{config_.ndt_resolution_m});
+}
 
 imu::ImuNoise LidarInertialOdometry::imuNoise() const {
   return {config_.imu.accel_noise_density, config_.imu.gyro_noise_density,
@@ -149,10 +156,11 @@ void LidarInertialOdometry::initialize(const io::Scan& first, const io::Scan& se
     const lie::SE3 T_world_first = poseOf(at_first_end);
     for (Eigen::Vector3d& p : target) p = T_world_first * p;
     registration::NdtConfig ndt;
-    ndt.resolution_m = config_.ndt_resolution_m;
+    const std::vector<double> resolutions_m = config_.ndtResolutionsM();
+    ndt.resolution_m = resolutions_m.back();
+    ndt.coarse_resolutions_m.assign(resolutions_m.begin(), resolutions_m.end() - 1);
     const registration::RegistrationResult r = registration::alignNdt(
-        preprocess::voxelFilter(second_in_body, config_.voxel_size_m).positions,
-        registration::NdtTarget::fromPoints(target, config_.ndt_resolution_m),
+        preprocess::voxelFilter(second_in_body, config_.voxel_size_m).positions, target,
         poseOf(over_second.back().state), ndt);
     if (r.num_inliers == 0 || !std::isfinite(r.hessian_condition)) {
       logger().warn(
@@ -337,14 +345,23 @@ registration::RegistrationResult LidarInertialOdometry::registerToMap(
   if (config_.method == "gicp") {
     result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),
                                      guess_T_world_body, {});
-  } else if (config_.method == "d2d") {
-    result = registration::alignD2dNdt(source, local_map_.ndtTarget(), guess_T_world_body, ndt);
   } else {
-    result = registration::alignNdt(source, local_map_.ndtTarget(), guess_T_world_body, ndt);
+    // Coarse to fine: each pass starts from the previous one's pose.
+    lie::SE3 guess = guess_T_world_body;
+    int iterations = 0;
+    for (const registration::NdtTarget* target : local_map_.ndtTargets()) {
+      result = config_.method == "d2d" ? registration::alignD2dNdt(source, *target, guess, ndt)
+                                       : registration::alignNdt(source, *target, guess, ndt);
+      iterations += result.iterations;
+      if (result.num_inliers == 0) break;
+      guess = result.T_target_source;
+    }
+    result.iterations = iterations;
   }
-  // Points farther than a few NDT cells from the map are new ground, not misalignment.
-  result.fitness_m2 = registration::fitnessScore(
-      source, local_map_.kdTree(), result.T_target_source, 2.0 * config_.ndt_resolution_m);
+  // Points farther than a few coarse NDT cells from the map are new ground, not misalignment.
+  result.fitness_m2 = registration::fitnessScore(source, local_map_.kdTree(),
+                                                 result.T_target_source,
+                                                 2.0 * config_.ndtResolutionsM().front());
   return result;
 }
 

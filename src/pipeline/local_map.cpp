@@ -4,13 +4,25 @@
 
 namespace taiga::pipeline {
 
-LocalMap::LocalMap(double ndt_resolution_m, double point_spacing_m, int max_keyframes,
-                   Target target, const registration::GicpConfig& gicp)
+LocalMap::LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m,
+                   int max_keyframes, Target target, const registration::GicpConfig& gicp)
     : max_keyframes_(max_keyframes),
       target_(target),
       gicp_config_(gicp),
-      statistics_(ndt_resolution_m),
-      point_statistics_(point_spacing_m) {}
+      point_statistics_(point_spacing_m) {
+  setNdtResolutions(ndt_resolutions_m);
+}
+
+void LocalMap::setNdtResolutions(const std::vector<double>& ndt_resolutions_m) {
+  if (ndt_resolutions_m.empty()) throw std::invalid_argument("LocalMap: no NDT resolution");
+  if (!keyframes_.empty()) throw std::logic_error("LocalMap: NDT resolutions set on a full map");
+  finishPendingBuild();
+  in_use_ = {};
+  ndt_statistics_.clear();
+  // Only the NDT target needs cells; GICP uses the points.
+  if (target_ == Target::kNdt)
+    for (double resolution_m : ndt_resolutions_m) ndt_statistics_.emplace_back(resolution_m);
+}
 
 LocalMap::~LocalMap() {
   if (pending_.valid()) pending_.wait();
@@ -20,7 +32,8 @@ LocalMap::SearchStructures LocalMap::build() const {
   SearchStructures built;
   const std::vector<Eigen::Vector3d> points = point_statistics_.means();
   if (target_ == Target::kNdt) {
-    built.ndt_target = std::make_unique<registration::NdtTarget>(statistics_);
+    for (const registration::VoxelStatistics& statistics : ndt_statistics_)
+      built.ndt_targets.push_back(std::make_unique<registration::NdtTarget>(statistics));
   } else {
     built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
   }
@@ -34,11 +47,12 @@ void LocalMap::finishPendingBuild() {
 
 void LocalMap::addKeyframe(std::vector<Eigen::Vector3d> points_in_world) {
   finishPendingBuild();  // it reads the statistics that change now
-  statistics_.add(points_in_world);
+  for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.add(points_in_world);
   point_statistics_.add(points_in_world);
   keyframes_.push_back(std::move(points_in_world));
   while (static_cast<int>(keyframes_.size()) > max_keyframes_) {
-    statistics_.remove(keyframes_.front());
+    for (registration::VoxelStatistics& statistics : ndt_statistics_)
+      statistics.remove(keyframes_.front());
     point_statistics_.remove(keyframes_.front());
     keyframes_.pop_front();
   }
@@ -55,7 +69,7 @@ void LocalMap::beginRegistration() {
 
 void LocalMap::clear() {
   finishPendingBuild();
-  statistics_.clear();
+  for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
   point_statistics_.clear();
   keyframes_.clear();
   in_use_ = {};
@@ -76,7 +90,14 @@ const T& inUse(const std::unique_ptr<T>& structure, const char* what) {
 }  // namespace
 
 const registration::NdtTarget& LocalMap::ndtTarget() const {
-  return inUse(in_use_.ndt_target, "NDT target");
+  if (in_use_.ndt_targets.empty()) throw std::logic_error("LocalMap: no NDT target in use");
+  return *in_use_.ndt_targets.back();
+}
+std::vector<const registration::NdtTarget*> LocalMap::ndtTargets() const {
+  std::vector<const registration::NdtTarget*> targets;
+  for (const auto& target : in_use_.ndt_targets) targets.push_back(target.get());
+  if (targets.empty()) throw std::logic_error("LocalMap: no NDT target in use");
+  return targets;
 }
 const registration::KdTree& LocalMap::kdTree() const { return inUse(in_use_.kd_tree, "kd-tree"); }
 const registration::GicpCloud& LocalMap::gicpCloud() const {

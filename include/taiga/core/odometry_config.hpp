@@ -3,6 +3,7 @@
 // local map, the lidar factor's covariance, keyframes and the IMU noise model.
 
 #include <string>
+#include <vector>
 
 #include "taiga/core/config.hpp"
 
@@ -37,10 +38,15 @@ struct OdometryConfig final : ConfigSection {
   /// IMU reading within its first 2 s of scans.
   std::string imu_use = "auto";
   std::string method = "ndt";  ///< ndt | d2d | gicp
-  double ndt_resolution_m = 1.0;
+  /// NDT cell edge of the final pass. 0.5 m rather than the thesis' 1 m: registration is pulled
+  /// toward where the map's points were seen from, which shortens every step by a fraction that
+  /// grows with the cell size (docs/odometry.md, "Scale").
+  double ndt_resolution_m = 0.5;
+  /// > 0: a first pass at this cell edge, for the wider basin of larger cells; 0: one pass.
+  double ndt_coarse_resolution_m = 1.0;
   std::string ndt_neighbours = "direct1";  ///< direct1 | direct7: NDT cells scored per point
   double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
-  int local_map_keyframes = 20;            ///< keyframes the local map holds
+  int local_map_keyframes = 16;            ///< keyframes the local map holds (docs/odometry.md, "Scale")
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
   double lidar_sigma = 0.01;            ///< sigma_sm: m and rad (roll, pitch; heading unless set below), at good fitness
   double lidar_heading_sigma_rad = 0.003;  ///< heading sigma at good fitness; 0: lidar_sigma
@@ -65,6 +71,10 @@ struct OdometryConfig final : ConfigSection {
   /// Thesis Eq. 36 as docs/odometry.md reads it: sigma_sm while the fitness is at most tau_fs,
   /// times (fitness / tau_fs)^theta_smsc above it, times `inflation`; heading with its own sigma.
   LidarSigmas lidarSigmas(double fitness_m2, double inflation = 1.0) const;
+
+  /// The NDT passes' cell edges, coarse to fine: {ndt_coarse_resolution_m, ndt_resolution_m},
+  /// or {ndt_resolution_m} alone when the coarse one is 0 or not coarser.
+  std::vector<double> ndtResolutionsM() const;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

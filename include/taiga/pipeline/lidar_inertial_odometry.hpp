@@ -87,8 +87,9 @@ class LidarInertialOdometry {
   void setMovingBoxes(MovingBoxes boxes_body) { moving_boxes_body_ = std::move(boxes_body); }
   /// Without an IMU: each scan is predicted and deskewed with the constant velocity of the last
   /// two poses and registered to the local map; the world frame is the first scan's body frame
-  /// (not levelled). Set before the first scan.
-  void setLidarOnly(bool lidar_only) { lidar_only_ = lidar_only; }
+  /// (not levelled). Set before the first scan. The constant-velocity prediction may be off by
+  /// decimetres, so registration then runs coarse to fine (OdometryConfig::ndtResolutionsM()).
+  void setLidarOnly(bool lidar_only);
   bool lidarOnly() const { return lidar_only_; }
 
   bool initialized() const { return lidar_only_ || smoother_.initialized(); }

@@ -29,10 +29,11 @@ class LocalMap {
   /// Registrations after a keyframe that still use the structures without it.
   static constexpr int kScansOnPreviousMap = 1;
 
-  /// NDT cells of ndt_resolution_m; the kd-tree (fitness, GICP) over one point per
-  /// point_spacing_m voxel, so overlapping keyframes do not multiply its size.
-  LocalMap(double ndt_resolution_m, double point_spacing_m, int max_keyframes, Target target,
-           const registration::GicpConfig& gicp = {});
+  /// NDT cells at each of ndt_resolutions_m (coarse to fine, at least one); the kd-tree
+  /// (fitness, GICP) over one point per point_spacing_m voxel, so overlapping keyframes do not
+  /// multiply its size.
+  LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m, int max_keyframes,
+           Target target, const registration::GicpConfig& gicp = {});
   ~LocalMap();
   LocalMap(const LocalMap&) = delete;  // the background build refers to this object
   LocalMap& operator=(const LocalMap&) = delete;
@@ -42,6 +43,8 @@ class LocalMap {
   void addKeyframe(std::vector<Eigen::Vector3d> points_in_world);
   /// Drops every keyframe.
   void clear();
+  /// Replaces the NDT passes (coarse to fine, at least one); only while the map is empty.
+  void setNdtResolutions(const std::vector<double>& ndt_resolutions_m);
   /// Call once before each registration: hands the background build over when its turn has come
   /// (at once when there was no map before).
   void beginRegistration();
@@ -50,14 +53,16 @@ class LocalMap {
   std::size_t numKeyframes() const { return keyframes_.size(); }
   std::size_t numPoints() const;
 
-  /// The structures in use (logic_error for the other target's).
+  /// The structures in use (logic_error for the other target's). ndtTarget() is the finest;
+  /// ndtTargets() all of them, coarse to fine.
   const registration::NdtTarget& ndtTarget() const;
+  std::vector<const registration::NdtTarget*> ndtTargets() const;
   const registration::KdTree& kdTree() const;
   const registration::GicpCloud& gicpCloud() const;
 
  private:
   struct SearchStructures {
-    std::unique_ptr<registration::NdtTarget> ndt_target;
+    std::vector<std::unique_ptr<registration::NdtTarget>> ndt_targets;  ///< coarse to fine
     std::unique_ptr<registration::GicpCloud> gicp_cloud;
     std::unique_ptr<registration::KdTree> kd_tree;
   };
@@ -69,7 +74,7 @@ class LocalMap {
   Target target_;
   registration::GicpConfig gicp_config_;
   std::deque<std::vector<Eigen::Vector3d>> keyframes_;
-  registration::VoxelStatistics statistics_;        ///< NDT cells
+  std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
   registration::VoxelStatistics point_statistics_;  ///< one mean per point_spacing_m voxel
   SearchStructures in_use_;
   std::future<SearchStructures> pending_;  ///< reads the statistics: they wait for it
