@@ -35,9 +35,11 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   static constexpr std::array<std::string_view, 3> kMethods{"ndt", "d2d", "gicp"};
   v.choice("method", method, kMethods,
            "scan-to-map registration: ndt, d2d (distribution-to-distribution) or gicp");
-  v.field("ndt_resolution_m", ndt_resolution_m, "m, NDT cell size of the local map (final pass)");
+  v.field("ndt_resolution_m", ndt_resolution_m,
+          "m, NDT cell size of the local map; 0.5 for 64 beams or more (docs/odometry.md, Scale)");
   v.field("ndt_coarse_resolution_m", ndt_coarse_resolution_m,
-          "m, NDT cell size of a first, coarser pass (wider basin); 0: one pass");
+          "m, cells of a first, coarser NDT pass without an IMU, for the first two scans and in "
+          "loop closure; 0 or not coarser than ndt_resolution_m: none");
   static constexpr std::array<std::string_view, 2> kNeighbours{"direct1", "direct7"};
   v.choice("ndt_neighbours", ndt_neighbours, kNeighbours,
            "NDT cells each scan point is scored against: its own (direct1) or also the six face "

@@ -34,6 +34,11 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
   config.odometry.imu.accel_bias_random_walk = imu.accel_bias_random_walk;
   config.odometry.imu.gyro_bias_random_walk = imu.gyro_bias_random_walk;
   config.odometry.imu.gravity_mps2 = imu.gravity_mps2;
+  if (simulation.lidar().rows() >= 64) {
+    // Dense scans: the settings of config/os0-128-handheld.yaml (docs/odometry.md, "Scale").
+    config.odometry.ndt_resolution_m = 0.5;
+    config.odometry.local_map_keyframes = 16;
+  }
   const LidarParams& lidar = simulation.scenario().lidar;
   std::string header = fmt::format(
       "# Rig of a simulated recording (taiga simulate --scenario {} --seed {} --duration {}).\n"

@@ -38,15 +38,15 @@ struct OdometryConfig final : ConfigSection {
   /// IMU reading within its first 2 s of scans.
   std::string imu_use = "auto";
   std::string method = "ndt";  ///< ndt | d2d | gicp
-  /// NDT cell edge of the final pass. 0.5 m rather than the thesis' 1 m: registration is pulled
-  /// toward where the map's points were seen from, which shortens every step by a fraction that
-  /// grows with the cell size (docs/odometry.md, "Scale").
-  double ndt_resolution_m = 0.5;
-  /// > 0: a first pass at this cell edge, for the wider basin of larger cells; 0: one pass.
+  /// NDT cell edge. The thesis' 1 m suits any lidar; with 64 beams or more 0.5 m shrinks the
+  /// odometry's steps less (docs/odometry.md, "Scale"; config/os0-128-*.yaml set it).
+  double ndt_resolution_m = 1.0;
+  /// Without an IMU, for the first two scans and in loop closure: a first pass at this coarser
+  /// cell edge, for its wider basin; 0 or not coarser than ndt_resolution_m: none.
   double ndt_coarse_resolution_m = 1.0;
   std::string ndt_neighbours = "direct1";  ///< direct1 | direct7: NDT cells scored per point
   double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
-  int local_map_keyframes = 16;            ///< keyframes the local map holds (docs/odometry.md, "Scale")
+  int local_map_keyframes = 20;            ///< keyframes the local map holds
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
   double lidar_sigma = 0.01;            ///< sigma_sm: m and rad (roll, pitch; heading unless set below), at good fitness
   double lidar_heading_sigma_rad = 0.003;  ///< heading sigma at good fitness; 0: lidar_sigma
