@@ -89,10 +89,6 @@ const T& inUse(const std::unique_ptr<T>& structure, const char* what) {
 }
 }  // namespace
 
-const registration::NdtTarget& LocalMap::ndtTarget() const {
-  if (in_use_.ndt_targets.empty()) throw std::logic_error("LocalMap: no NDT target in use");
-  return *in_use_.ndt_targets.back();
-}
 std::vector<const registration::NdtTarget*> LocalMap::ndtTargets() const {
   std::vector<const registration::NdtTarget*> targets;
   for (const auto& target : in_use_.ndt_targets) targets.push_back(target.get());

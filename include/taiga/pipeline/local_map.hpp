@@ -53,9 +53,7 @@ class LocalMap {
   std::size_t numKeyframes() const { return keyframes_.size(); }
   std::size_t numPoints() const;
 
-  /// The structures in use (logic_error for the other target's). ndtTarget() is the finest;
-  /// ndtTargets() all of them, coarse to fine.
-  const registration::NdtTarget& ndtTarget() const;
+  /// The structures in use (logic_error for the other target's); the NDT targets coarse to fine.
   std::vector<const registration::NdtTarget*> ndtTargets() const;
   const registration::KdTree& kdTree() const;
   const registration::GicpCloud& gicpCloud() const;
