@@ -119,8 +119,8 @@ KeyframeStore KeyframeStore::create(const std::filesystem::path& dir,
 KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStoreOptions options) {
   const std::filesystem::path poses_path = dir / kPosesFile;
   if (!std::filesystem::exists(poses_path))
-    throw InputError(fmt::format("{}: missing: not a keyframe directory of taiga run",
-                                 poses_path.string()));
+    throw InputError(
+        fmt::format("{}: missing: not a keyframe directory of taiga run", poses_path.string()));
   const Trajectory poses = io::readTum(poses_path);
   // Only the headers: the registration copies are rebuilt from the files when first asked for.
   KeyframeStore store(std::make_unique<Impl>(dir, options));
@@ -152,13 +152,13 @@ std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_world_body,
     const std::lock_guard lock(impl_->mutex);
     id = impl_->infos.size();
     if (!impl_->infos.empty() && !(t_s > impl_->infos.back().t_s))
-      throw std::invalid_argument(fmt::format("KeyframeStore::add: time {} is not after {}", t_s,
-                                              impl_->infos.back().t_s));
+      throw std::invalid_argument(
+          fmt::format("KeyframeStore::add: time {} is not after {}", t_s, impl_->infos.back().t_s));
   }
   // The slow parts (file, voxel filter) outside the lock: readers of other keyframes go on.
   writeKeyframeFile(keyframePath(id), id, t_s, cloud_in_body);
-  KeyframeInfo info{.id = id, .t_s = t_s, .T_world_body = T_world_body,
-                    .point_count = cloud_in_body.size()};
+  KeyframeInfo info{
+      .id = id, .t_s = t_s, .T_world_body = T_world_body, .point_count = cloud_in_body.size()};
   if (impl_->options.registration_voxel_m > 0.0) {
     // The newest keyframe is the one loop closure asks for next: cache its copy now, from the
     // scan at hand, rather than read the file back.
@@ -187,9 +187,10 @@ PointCloud KeyframeStore::load(std::uint64_t id) const {
   const KeyframeInfo info = this->info(id);
   KeyframeFileContent content = readKeyframeFile(keyframePath(id));
   if (content.header.id != id || content.header.point_count != info.point_count) {
-    throw InputError(fmt::format("{}: holds keyframe {} with {} points, expected keyframe {} with {}",
-                                 keyframePath(id).string(), content.header.id,
-                                 content.header.point_count, id, info.point_count));
+    throw InputError(
+        fmt::format("{}: holds keyframe {} with {} points, expected keyframe {} with {}",
+                    keyframePath(id).string(), content.header.id, content.header.point_count, id,
+                    info.point_count));
   }
   return std::move(content.cloud_in_body);
 }
@@ -252,10 +253,15 @@ void KeyframeStore::setPoses(const std::vector<lie::SE3>& poses_T_world_body) {
     impl_->infos[k].T_world_body = poses_T_world_body[k];
 }
 
-void KeyframeStore::writePoses() const {
+void KeyframeStore::writePoses() const { writePoses(trajectory()); }
+
+void KeyframeStore::writePoses(const Trajectory& poses_T_world_body) const {
+  if (poses_T_world_body.size() > size())
+    throw std::invalid_argument(fmt::format("KeyframeStore::writePoses: {} poses for {} keyframes",
+                                            poses_T_world_body.size(), size()));
   const std::filesystem::path path = impl_->dir / kPosesFile;
   const std::filesystem::path temporary = impl_->dir / (std::string(kPosesFile) + ".tmp");
-  io::writeTum(temporary, trajectory());
+  io::writeTum(temporary, poses_T_world_body);
   std::error_code ec;
   std::filesystem::rename(temporary, path, ec);
   if (ec) throw InputError(fmt::format("{}: cannot write: {}", path.string(), ec.message()));

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <utility>
 
@@ -37,6 +38,12 @@ void Mapper::finish() {
   if (gnss_ && gnss_->finish(graph_)) graph_.optimize();
 }
 
+Trajectory Mapper::keyframeTrajectory() const {
+  Trajectory out;
+  for (std::size_t k = 0; k < graph_.size(); ++k) out.append(keyframe_times_s_[k], graph_.pose(k));
+  return out;
+}
+
 std::optional<GnssFusionReport> Mapper::gnssReport() const {
   if (!gnss_) return std::nullopt;
   return gnss_->report(graph_);
@@ -49,8 +56,8 @@ void Mapper::tryLoopClosure(std::size_t current, double t_s) {
   // would be charged to the loop.
   if (graph_.hasUnsolvedFactors()) graph_.optimize();
   last_attempt_s_ = t_s;
-  LoopRecord record{.t_s = t_s,
-                    .attempt = verify_loop_(graph_, store_, current, *candidate, config_, odometry_)};
+  LoopRecord record{
+      .t_s = t_s, .attempt = verify_loop_(graph_, store_, current, *candidate, config_, odometry_)};
   if (record.attempt.accepted) {
     record.chi2 = graph_.addLoopIfConsistent(record.attempt.loop, config_.loop_max_chi2);
     if (record.chi2 <= config_.loop_max_chi2) {
@@ -67,8 +74,11 @@ void Mapper::tryLoopClosure(std::size_t current, double t_s) {
 }
 
 MappingThread::MappingThread(const MappingConfig& config, const OdometryConfig& odometry,
-                             const KeyframeStore& store)
-    : mapper_(config, odometry, store), worker_([this] { work(); }) {}
+                             const KeyframeStore& store, MappingThreadOptions options)
+    : mapper_(config, odometry, store),
+      store_(store),
+      options_(options),
+      worker_([this] { work(); }) {}
 
 MappingThread::~MappingThread() {
   {
@@ -107,6 +117,7 @@ void MappingThread::work() {
     try {
       if (const auto* keyframe = std::get_if<KeyframeMessage>(&message)) {
         mapper_.addKeyframe(keyframe->id, keyframe->t_s, keyframe->T_odom_body);
+        publish(keyframe->id);
       } else if (const auto* fix = std::get_if<GnssFix>(&message)) {
         mapper_.addGnssFix(*fix);
       } else {
@@ -115,10 +126,40 @@ void MappingThread::work() {
     } catch (...) {
       lock.lock();
       error_ = std::current_exception();
+      snapshot_ready_.notify_all();
       continue;
     }
     lock.lock();
   }
+}
+
+void MappingThread::publish(std::size_t id) {
+  if (options_.write_live_poses) store_.writePoses(mapper_.keyframeTrajectory());
+  if (options_.snapshot_keyframes == 0) return;
+  const std::vector<lie::SE3>& poses = mapper_.graph().poses();
+  const std::size_t count = std::min(options_.snapshot_keyframes, poses.size());
+  GraphSnapshot snapshot{
+      .keyframe = id,
+      .poses_T_world_body = std::vector<lie::SE3>(poses.end() - count, poses.end())};
+  {
+    const std::lock_guard lock(mutex_);
+    snapshots_.push_back(std::move(snapshot));
+  }
+  snapshot_ready_.notify_all();
+}
+
+std::optional<GraphSnapshot> MappingThread::waitForSnapshot(std::size_t keyframe) {
+  if (options_.snapshot_keyframes == 0)
+    throw std::logic_error("MappingThread::waitForSnapshot: snapshots are off");
+  std::unique_lock lock(mutex_);
+  snapshot_ready_.wait(lock, [&] {
+    return error_ || (!snapshots_.empty() && snapshots_.back().keyframe >= keyframe);
+  });
+  while (!snapshots_.empty() && snapshots_.front().keyframe < keyframe) snapshots_.pop_front();
+  if (snapshots_.empty() || snapshots_.front().keyframe != keyframe) return std::nullopt;
+  GraphSnapshot snapshot = std::move(snapshots_.front());
+  snapshots_.pop_front();
+  return snapshot;
 }
 
 Mapper& MappingThread::finish() {

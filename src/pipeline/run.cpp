@@ -70,9 +70,9 @@ Trajectory transformed(const Trajectory& trajectory, const lie::SE3& T_new_old) 
 // GNSS fused in the mapping graph (mapping.gnss_fusion): what became of the fixes and the
 // graph's T_enu_world (docs/mapping.md).
 nlohmann::ordered_json gnssFusionJson(const mapping::GnssFusionReport& r) {
-  nlohmann::ordered_json j = {{"fixes", r.total},     {"gated", r.gated},
-                              {"outside_keyframes", r.outside}, {"waiting", r.waiting},
-                              {"used", r.used},       {"down_weighted", r.down_weighted}};
+  nlohmann::ordered_json j = {
+      {"fixes", r.total},     {"gated", r.gated}, {"outside_keyframes", r.outside},
+      {"waiting", r.waiting}, {"used", r.used},   {"down_weighted", r.down_weighted}};
   if (r.enu_origin)
     j["enu_origin"] = {{"latitude_deg", r.enu_origin->latitude_deg},
                        {"longitude_deg", r.enu_origin->longitude_deg},
@@ -130,9 +130,13 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
                      {"outliers", g.outliers},
                      {"horizontal_rms_m", g.horizontal_rms_m},
                      {"vertical_rms_m", g.vertical_rms_m},
-                     {"sigma", {{"east_m", g.sigma[0]}, {"north_m", g.sigma[1]},
-                                {"up_m", g.sigma[2]}, {"roll_deg", g.sigma[3] * kDeg},
-                                {"pitch_deg", g.sigma[4] * kDeg}, {"yaw_deg", g.sigma[5] * kDeg}}},
+                     {"sigma",
+                      {{"east_m", g.sigma[0]},
+                       {"north_m", g.sigma[1]},
+                       {"up_m", g.sigma[2]},
+                       {"roll_deg", g.sigma[3] * kDeg},
+                       {"pitch_deg", g.sigma[4] * kDeg},
+                       {"yaw_deg", g.sigma[5] * kDeg}}},
                      {"map_export_s", g.map_export_s}});
     }
     j["georef"] = georef;
@@ -160,7 +164,8 @@ bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
   return false;  // too short to tell: the odometry will say what it lacks
 }
 
-std::vector<lie::SE3> transformedPoses(const std::vector<lie::SE3>& poses, const lie::SE3& T_new_old) {
+std::vector<lie::SE3> transformedPoses(const std::vector<lie::SE3>& poses,
+                                       const lie::SE3& T_new_old) {
   std::vector<lie::SE3> out;
   out.reserve(poses.size());
   for (const lie::SE3& T_old_body : poses) out.push_back(T_new_old * T_old_body);
@@ -212,8 +217,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   mapping::KeyframeStore keyframe_store = mapping::KeyframeStore::create(
       options.out_dir / "keyframes", {.registration_voxel_m = config.odometry.voxel_size_m});
   // The mapping graph runs beside the odometry and corrects the keyframe poses at the end. The
-  // odometry does not wait for it, and its trajectory does not depend on it.
-  mapping::MappingThread mapping_thread(config.mapping, config.odometry, keyframe_store);
+  // odometry does not wait for it, and its trajectory does not depend on it. After every
+  // keyframe it rewrites keyframes/poses.tum, so `taiga export-map` gives the map so far.
+  mapping::MappingThread mapping_thread(config.mapping, config.odometry, keyframe_store,
+                                        {.write_live_poses = true});
   std::vector<double> keyframe_times_s;
   // The live georeference of each scan's pose, from the fixes received so far (georef/online.hpp).
   std::optional<georef::OnlineGeoreferencer> online_georef;
@@ -242,8 +249,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
     if (online_georef) {
       online_georef->addPose(outcome.t_s, outcome.T_world_body);
       if (auto grid = online_georef->toGrid(outcome.t_s, outcome.T_world_body))
-        online_poses.push_back({*grid, online_georef->estimate()->fit.sigma,
-                                online_georef->estimate()->fixes});
+        online_poses.push_back(
+            {*grid, online_georef->estimate()->fit.sigma, online_georef->estimate()->fixes});
     }
     appendIfLater(trajectory, outcome.t_s, outcome.T_world_body);
     for (const StampedPose& p : outcome.imu_rate_poses)
@@ -262,7 +269,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                          r.iterations, r.converged ? 1 : 0, r.num_inliers, r.hessian_condition,
                          outcome.source_points, outcome.keyframe ? 1 : 0, outcome.lidar_note);
     if (outcome.keyframe_cloud_in_body &&
-        (keyframe_store.empty() || outcome.t_s > keyframe_store.info(keyframe_store.size() - 1).t_s)) {
+        (keyframe_store.empty() ||
+         outcome.t_s > keyframe_store.info(keyframe_store.size() - 1).t_s)) {
       const std::uint64_t id =
           keyframe_store.add(outcome.t_s, outcome.T_world_body, *outcome.keyframe_cloud_in_body);
       mapping_thread.addKeyframe(id, outcome.t_s, outcome.T_world_body);
@@ -302,10 +310,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   std::deque<io::RecordingEvent> read_ahead;
   const bool lidar_only = useLidarOnly(recording, config.odometry.imu_use, read_ahead);
   if (lidar_only) {
-    logger().info("lidar-only odometry{}: constant-velocity prediction and deskew, world frame = "
-                  "the first scan's body frame (not levelled)",
-                  config.odometry.imu_use == "auto" ? " (no IMU reading with the first 2 s of scans)"
-                                                    : "");
+    logger().info(
+        "lidar-only odometry{}: constant-velocity prediction and deskew, world frame = "
+        "the first scan's body frame (not levelled)",
+        config.odometry.imu_use == "auto" ? " (no IMU reading with the first 2 s of scans)" : "");
   }
   odometry.setLidarOnly(lidar_only);
   for (const io::RecordingEvent& event : read_ahead) handle(event);
@@ -366,10 +374,11 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
     writeOnlineGeoreference(options.out_dir / "georef", online_poses, config.georef.epsg);
   }
   if (!gnss.fixes.empty()) {
-    summary.georef = georeferenceRun(
-        corrected, gnss, config, recording_path.string(),
-        {.store = keyframe_store, .poses_T_world_body = keyframe_poses, .voxel_m = options.map_voxel_m},
-        options.out_dir);
+    summary.georef = georeferenceRun(corrected, gnss, config, recording_path.string(),
+                                     {.store = keyframe_store,
+                                      .poses_T_world_body = keyframe_poses,
+                                      .voxel_m = options.map_voxel_m},
+                                     options.out_dir);
   }
 
   summary.duration_s = trajectory.endTime() - trajectory.startTime();

@@ -11,7 +11,7 @@
 // are kept in RAM; setPoses() replaces them when the world frame is levelled or the mapping
 // graph corrects them, and writePoses() saves them as DIR/poses.tum (TUM, T_world_body, one line
 // per keyframe in id order), so that `taiga export-map DIR` re-exports a finished run with its
-// final poses.
+// final poses, or a running one with its current poses.
 //
 // Ids are 0, 1, 2, ... in the order of add(). Thread-safe: one thread may add() while others
 // call load(), registrationCloud(), pose() or setPoses(). A registration copy handed out stays
@@ -98,6 +98,11 @@ class KeyframeStore {
   void setPoses(const std::vector<lie::SE3>& poses_T_world_body);
   /// Rewrites DIR/poses.tum from the poses in RAM (write to a temporary file, then rename).
   void writePoses() const;
+  /// Rewrites DIR/poses.tum with these poses of keyframes 0, 1, ... (their times and T_world_body;
+  /// may be fewer than the store holds), the same way. A running `taiga run` publishes its
+  /// mapping graph's current poses so, and open() then sees a consistent snapshot of the run:
+  /// every keyframe it lists has its file complete.
+  void writePoses(const Trajectory& poses_T_world_body) const;
 
  private:
   struct Impl;

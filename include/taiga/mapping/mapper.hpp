@@ -19,6 +19,7 @@
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/core/sensor_samples.hpp"
+#include "taiga/core/trajectory.hpp"
 #include "taiga/mapping/gnss_fusion.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/mapping/loop_closure.hpp"
@@ -59,6 +60,8 @@ class Mapper {
   std::optional<GnssFusionReport> gnssReport() const;
 
   const PoseGraph& graph() const { return graph_; }
+  /// The graph's current keyframe poses at the keyframes' times.
+  Trajectory keyframeTrajectory() const;
   const std::vector<LoopRecord>& loopAttempts() const { return attempts_; }
   std::size_t loopClosures() const { return graph_.loops().size(); }
 
@@ -76,12 +79,28 @@ class Mapper {
   std::vector<LoopRecord> attempts_;
 };
 
+/// The mapping graph's poses of the newest keyframes right after it handled one keyframe: what
+/// the odometry rebuilds its local map from (MappingConfig::correct_odometry).
+struct GraphSnapshot {
+  std::size_t keyframe = 0;                  ///< the keyframe just handled, the last of the poses
+  std::vector<lie::SE3> poses_T_world_body;  ///< keyframes keyframe - size + 1 ... keyframe
+};
+
+struct MappingThreadOptions {
+  /// Rewrite the store's poses.tum with the graph's poses after every keyframe, so that
+  /// `taiga export-map` can export the map of a run still going.
+  bool write_live_poses = false;
+  /// > 0: after every keyframe, keep a GraphSnapshot of this many keyframes for
+  /// waitForSnapshot().
+  std::size_t snapshot_keyframes = 0;
+};
+
 /// A Mapper on its own thread. Messages are handled in order, so the result does not depend on
 /// timing: the same recording gives the same map.
 class MappingThread {
  public:
   MappingThread(const MappingConfig& config, const OdometryConfig& odometry,
-                const KeyframeStore& store);
+                const KeyframeStore& store, MappingThreadOptions options = {});
   ~MappingThread();
   MappingThread(const MappingThread&) = delete;
   MappingThread& operator=(const MappingThread&) = delete;
@@ -91,6 +110,11 @@ class MappingThread {
   /// Fixes are handled in the order of the calls, interleaved with the keyframes, so the
   /// result depends on that order only, not on the thread's timing.
   void addGnssFix(const GnssFix& fix);
+  /// Waits until the thread has handled keyframe `keyframe` and returns the graph's snapshot
+  /// taken then (options.snapshot_keyframes > 0), dropping the older ones; nothing when the
+  /// thread failed (finish() rethrows). The snapshot depends on the order of the calls only, not
+  /// on the thread's timing.
+  std::optional<GraphSnapshot> waitForSnapshot(std::size_t keyframe);
   /// Waits until every message is handled, stops the thread, finishes the mapper
   /// (Mapper::finish) and hands it out. Rethrows what the thread threw.
   Mapper& finish();
@@ -104,11 +128,17 @@ class MappingThread {
   using Message = std::variant<KeyframeMessage, lie::SE3, GnssFix>;
   void push(Message message);
   void work();
+  /// After keyframe `id`: the live poses and the snapshot, as options_ asks.
+  void publish(std::size_t id);
 
   Mapper mapper_;
+  const KeyframeStore& store_;
+  MappingThreadOptions options_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<Message> queue_;
+  std::deque<GraphSnapshot> snapshots_;  ///< oldest first
+  std::condition_variable snapshot_ready_;
   bool stopping_ = false;
   bool finished_ = false;
   std::exception_ptr error_;
