@@ -5,6 +5,9 @@ namespace taiga {
 void MappingConfig::visit(ConfigVisitor& v) {
   v.field("loop_closure", loop_closure,
           "search for loop closures and correct the keyframe poses with them");
+  v.field("correct_odometry", correct_odometry,
+          "feed the graph's corrections back into the running odometry: its live pose and local "
+          "map follow the corrected keyframe poses (two keyframes later)");
   v.field("loop_exclude_recent_keyframes", loop_exclude_recent_keyframes,
           "keyframes, the most recent ones are never loop candidates (thesis: 40)");
   v.field("loop_search_radius_m", loop_search_radius_m,
@@ -52,8 +55,8 @@ void MappingConfig::validate() const {
                  "keyframes");
   requirePositive("loop_search_radius_m", loop_search_radius_m, "m");
   requireNonNegative("loop_radius_growth_m_per_m", loop_radius_growth_m_per_m, "m/m");
-  requireInRange("loop_max_search_radius_m", loop_max_search_radius_m, loop_search_radius_m,
-                 1000.0, "m");
+  requireInRange("loop_max_search_radius_m", loop_max_search_radius_m, loop_search_radius_m, 1000.0,
+                 "m");
   requireNonNegative("loop_min_interval_s", loop_min_interval_s, "s");
   requireInRange("loop_submap_keyframes", loop_submap_keyframes, 1, 100, "keyframes");
   requirePositive("loop_max_fitness_m2", loop_max_fitness_m2, "m^2");

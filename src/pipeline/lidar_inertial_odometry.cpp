@@ -107,7 +107,8 @@ PointCloud LidarInertialOdometry::deskewScan(const io::Scan& scan, const imu::Na
     for (std::size_t k = 1; k < states.size(); ++k)
       imu_rate_poses->push_back({states[k].t_s, poseOf(states[k].state)});
   }
-  return preprocess::deskew(forestPointsInLidar(scan), rig_.T_body_lidar, imu::toTrajectory(states), scan.t_end_s)
+  return preprocess::deskew(forestPointsInLidar(scan), rig_.T_body_lidar, imu::toTrajectory(states),
+                            scan.t_end_s)
       .cloud_in_body;
 }
 
@@ -140,16 +141,17 @@ void LidarInertialOdometry::initialize(const io::Scan& first, const io::Scan& se
   PointCloud first_in_body;
   for (int round = 0; round < 2; ++round) {
     const std::vector<ImuSample> readings = imu_.between(t_init_s, second.t_end_s);
-    const auto over_first = imu::propagateThrough(at_first_start, t_init_s, first.t_end_s,
-                                                  readings, init.bias, gravity_world_);
+    const auto over_first = imu::propagateThrough(at_first_start, t_init_s, first.t_end_s, readings,
+                                                  init.bias, gravity_world_);
     at_first_end = over_first.back().state;
-    first_in_body =
-        preprocess::deskew(forestPointsInLidar(first), rig_.T_body_lidar, imu::toTrajectory(over_first), first.t_end_s)
-            .cloud_in_body;
+    first_in_body = preprocess::deskew(forestPointsInLidar(first), rig_.T_body_lidar,
+                                       imu::toTrajectory(over_first), first.t_end_s)
+                        .cloud_in_body;
     const auto over_second = imu::propagateThrough(at_first_end, first.t_end_s, second.t_end_s,
                                                    readings, init.bias, gravity_world_);
     const PointCloud second_in_body =
-        preprocess::deskew(forestPointsInLidar(second), rig_.T_body_lidar, imu::toTrajectory(over_second), second.t_end_s)
+        preprocess::deskew(forestPointsInLidar(second), rig_.T_body_lidar,
+                           imu::toTrajectory(over_second), second.t_end_s)
             .cloud_in_body;
     std::vector<Eigen::Vector3d> target =
         preprocess::voxelFilter(first_in_body, config_.local_map_voxel_m).positions;
@@ -359,14 +361,14 @@ registration::RegistrationResult LidarInertialOdometry::registerToMap(
     result.iterations = iterations;
   }
   // Points farther than a few coarse NDT cells from the map are new ground, not misalignment.
-  result.fitness_m2 = registration::fitnessScore(source, local_map_.kdTree(),
-                                                 result.T_target_source,
-                                                 2.0 * config_.ndtResolutionsM().front());
+  result.fitness_m2 = registration::fitnessScore(
+      source, local_map_.kdTree(), result.T_target_source, 2.0 * config_.ndtResolutionsM().front());
   return result;
 }
 
-std::optional<backend::PoseMeasurement> LidarInertialOdometry::judge(
-    ScanOutcome& outcome, const lie::SE3& predicted, bool check_jump) const {
+std::optional<backend::PoseMeasurement> LidarInertialOdometry::judge(ScanOutcome& outcome,
+                                                                     const lie::SE3& predicted,
+                                                                     bool check_jump) const {
   const registration::RegistrationResult& r = outcome.registration;
   const lie::Vector6 jump = (predicted.inverse() * r.T_target_source).Log();
   const double jump_m = jump.head<3>().norm(), jump_deg = jump.tail<3>().norm() / kDegToRad;
@@ -476,6 +478,33 @@ void LidarInertialOdometry::levelWorld(ScanOutcome& outcome) {
       fmt::format("; levelled after {:.1f} s by {:.2f} deg", config_.gravity_alignment_s, tilt_deg);
 }
 
+void LidarInertialOdometry::correctWorld(
+    const lie::SE3& T_new_old,
+    const std::function<lie::SE3(double t_s, const lie::SE3& T_old_keyframe)>&
+        T_world_keyframe_at) {
+  if (last_keyframe_T_world_body_)
+    last_keyframe_T_world_body_ = T_new_old * *last_keyframe_T_world_body_;
+  if (constant_velocity_)
+    constant_velocity_->T_world_body = T_new_old * constant_velocity_->T_world_body;
+  if (!lidar_only_ && smoother_.initialized()) {
+    // The latest state and its marginal covariance, re-expressed: the window before it is
+    // summarized by that marginal, as when the oldest state is marginalized.
+    backend::StateEstimate moved = smoother_.latest();
+    const lie::SO3& R_new_old = T_new_old.rotation();
+    moved.state.R_world_body = R_new_old * moved.state.R_world_body;
+    moved.state.p_world = T_new_old * moved.state.p_world;
+    moved.state.v_world = R_new_old * moved.state.v_world;
+    // Tangent [dp; dtheta; dv; dba; dbg]: dp and dv are world-frame vectors and turn with it;
+    // dtheta (body frame) and the biases do not.
+    backend::Matrix15 J = backend::Matrix15::Identity();
+    J.block<3, 3>(0, 0) = R_new_old.matrix();
+    J.block<3, 3>(6, 6) = R_new_old.matrix();
+    moved.covariance = J * moved.covariance * J.transpose();
+    smoother_.initialize(moved);
+  }
+  local_map_.repose(T_world_keyframe_at);
+}
+
 void LidarInertialOdometry::maybeAddKeyframe(ScanOutcome& outcome,
                                              const PointCloud& cloud_in_body) {
   if (last_keyframe_T_world_body_) {
@@ -488,10 +517,9 @@ void LidarInertialOdometry::maybeAddKeyframe(ScanOutcome& outcome,
   }
   outcome.keyframe = true;
   last_keyframe_T_world_body_ = outcome.T_world_body;
-  std::vector<Eigen::Vector3d> points_in_world =
-      preprocess::voxelFilter(cloud_in_body, config_.local_map_voxel_m).positions;
-  for (Eigen::Vector3d& p : points_in_world) p = outcome.T_world_body * p;
-  local_map_.addKeyframe(std::move(points_in_world));
+  local_map_.addKeyframe(
+      outcome.t_s, outcome.T_world_body,
+      preprocess::voxelFilter(cloud_in_body, config_.local_map_voxel_m).positions);
   outcome.keyframe_cloud_in_body = cloud_in_body;
 }
 

@@ -4,8 +4,8 @@
 
 namespace taiga::pipeline {
 
-LocalMap::LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m,
-                   int max_keyframes, Target target, const registration::GicpConfig& gicp)
+LocalMap::LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m, int max_keyframes,
+                   Target target, const registration::GicpConfig& gicp)
     : max_keyframes_(max_keyframes),
       target_(target),
       gicp_config_(gicp),
@@ -45,19 +45,45 @@ void LocalMap::finishPendingBuild() {
   if (pending_.valid()) in_use_ = pending_.get();
 }
 
-void LocalMap::addKeyframe(std::vector<Eigen::Vector3d> points_in_world) {
+void LocalMap::account(const Keyframe& keyframe, int sign) {
+  std::vector<Eigen::Vector3d> points_in_world = keyframe.points_in_keyframe;
+  for (Eigen::Vector3d& p : points_in_world) p = keyframe.T_world_keyframe * p;
+  for (registration::VoxelStatistics& statistics : ndt_statistics_) {
+    if (sign > 0)
+      statistics.add(points_in_world);
+    else
+      statistics.remove(points_in_world);
+  }
+  if (sign > 0)
+    point_statistics_.add(points_in_world);
+  else
+    point_statistics_.remove(points_in_world);
+}
+
+void LocalMap::addKeyframe(double t_s, const lie::SE3& T_world_keyframe,
+                           std::vector<Eigen::Vector3d> points_in_keyframe) {
   finishPendingBuild();  // it reads the statistics that change now
-  for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.add(points_in_world);
-  point_statistics_.add(points_in_world);
-  keyframes_.push_back(std::move(points_in_world));
+  keyframes_.push_back({t_s, T_world_keyframe, std::move(points_in_keyframe)});
+  account(keyframes_.back(), +1);
   while (static_cast<int>(keyframes_.size()) > max_keyframes_) {
-    for (registration::VoxelStatistics& statistics : ndt_statistics_)
-      statistics.remove(keyframes_.front());
-    point_statistics_.remove(keyframes_.front());
+    account(keyframes_.front(), -1);
     keyframes_.pop_front();
   }
   pending_ = std::async(std::launch::async, [this] { return build(); });
   registrations_since_keyframe_ = 0;
+}
+
+void LocalMap::repose(const std::function<lie::SE3(double t_s, const lie::SE3& T_world_keyframe)>&
+                          T_world_keyframe_at) {
+  finishPendingBuild();
+  for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
+  point_statistics_.clear();
+  for (Keyframe& keyframe : keyframes_) {
+    keyframe.T_world_keyframe = T_world_keyframe_at(keyframe.t_s, keyframe.T_world_keyframe);
+    account(keyframe, +1);
+  }
+  in_use_ = {};  // so that beginRegistration() waits for the structures in the new frame
+  if (!keyframes_.empty()) pending_ = std::async(std::launch::async, [this] { return build(); });
 }
 
 void LocalMap::beginRegistration() {
@@ -77,7 +103,7 @@ void LocalMap::clear() {
 
 std::size_t LocalMap::numPoints() const {
   std::size_t n = 0;
-  for (const auto& keyframe : keyframes_) n += keyframe.size();
+  for (const Keyframe& keyframe : keyframes_) n += keyframe.points_in_keyframe.size();
   return n;
 }
 

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "odometry_correction.hpp"
 #include "recording_feed.hpp"
 #include "run_georef.hpp"
 #include "taiga/core/errors.hpp"
@@ -97,6 +98,8 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"imu_samples", s.imu_samples},
       {"keyframes", s.keyframes},
       {"loop_closures", s.loop_closures},
+      {"odometry_corrections", {{"applied", s.odometry_corrections},
+                                {"wait_s", s.odometry_correction_wait_s}}},
       {"registration_failures", s.lidar_rejected},
       {"lidar_factors_inflated", s.lidar_inflated},
       {"map_points", s.map_points},
@@ -219,8 +222,12 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   // The mapping graph runs beside the odometry and corrects the keyframe poses at the end. The
   // odometry does not wait for it, and its trajectory does not depend on it. After every
   // keyframe it rewrites keyframes/poses.tum, so `taiga export-map` gives the map so far.
-  mapping::MappingThread mapping_thread(config.mapping, config.odometry, keyframe_store,
-                                        {.write_live_poses = true});
+  const bool correct_odometry = config.mapping.correct_odometry;
+  mapping::MappingThread mapping_thread(
+      config.mapping, config.odometry, keyframe_store,
+      {.write_live_poses = true,
+       .snapshot_keyframes =
+           correct_odometry ? static_cast<std::size_t>(config.odometry.local_map_keyframes) : 0});
   std::vector<double> keyframe_times_s;
   // The live georeference of each scan's pose, from the fixes received so far (georef/online.hpp).
   std::optional<georef::OnlineGeoreferencer> online_georef;
@@ -236,26 +243,37 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                     options.show_progress && isatty(fileno(stderr)));
   const auto wall_start = Clock::now();
 
+  // The graph's corrections fed back into the odometry (odometry_correction.hpp). The odometry's
+  // live poses go to trajectory_online.tum; every other output is in the continuous odom frame
+  // the mapping graph works in (T_odom_body = T_world_odom^-1 * T_world_body).
+  OdometryCorrection correction;
+  Trajectory trajectory_online;
+  double correction_wait_s = 0.0;
   auto consume = [&](const ScanOutcome& outcome) {
     ++summary.scans_processed;
-    if (outcome.world_correction) {
+    if (outcome.world_correction) {  // levelling, before any correction from the graph
       const lie::SE3& T_new_old = *outcome.world_correction;
       trajectory = transformed(trajectory, T_new_old);
       trajectory_imu = transformed(trajectory_imu, T_new_old);
+      trajectory_online = transformed(trajectory_online, T_new_old);
       keyframe_store.setPoses(transformedPoses(keyframe_store.poses(), T_new_old));
+      correction.changeOdomFrame(T_new_old);
       mapping_thread.changeWorldFrame(T_new_old);
       if (online_georef) online_georef->changeWorldFrame(T_new_old);
     }
+    appendIfLater(trajectory_online, outcome.t_s, outcome.T_world_body);
+    const lie::SE3 T_odom_world = correction.T_world_odom().inverse();
+    const lie::SE3 T_odom_body = T_odom_world * outcome.T_world_body;
     if (online_georef) {
-      online_georef->addPose(outcome.t_s, outcome.T_world_body);
-      if (auto grid = online_georef->toGrid(outcome.t_s, outcome.T_world_body))
+      online_georef->addPose(outcome.t_s, T_odom_body);
+      if (auto grid = online_georef->toGrid(outcome.t_s, T_odom_body))
         online_poses.push_back(
             {*grid, online_georef->estimate()->fit.sigma, online_georef->estimate()->fixes});
     }
-    appendIfLater(trajectory, outcome.t_s, outcome.T_world_body);
+    appendIfLater(trajectory, outcome.t_s, T_odom_body);
     for (const StampedPose& p : outcome.imu_rate_poses)
-      appendIfLater(trajectory_imu, p.t_s, p.pose);
-    appendIfLater(trajectory_imu, outcome.t_s, outcome.T_world_body);
+      appendIfLater(trajectory_imu, p.t_s, T_odom_world * p.pose);
+    appendIfLater(trajectory_imu, outcome.t_s, T_odom_body);
     summary.lidar_rejected += outcome.lidar == LidarFactor::kRejected;
     summary.lidar_inflated += outcome.lidar == LidarFactor::kInflated;
     totals_ms.push_back(outcome.timing.total_ms);
@@ -272,10 +290,20 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
         (keyframe_store.empty() ||
          outcome.t_s > keyframe_store.info(keyframe_store.size() - 1).t_s)) {
       const std::uint64_t id =
-          keyframe_store.add(outcome.t_s, outcome.T_world_body, *outcome.keyframe_cloud_in_body);
-      mapping_thread.addKeyframe(id, outcome.t_s, outcome.T_world_body);
+          keyframe_store.add(outcome.t_s, T_odom_body, *outcome.keyframe_cloud_in_body);
+      mapping_thread.addKeyframe(id, outcome.t_s, T_odom_body);
       keyframe_times_s.push_back(outcome.t_s);
+      correction.addKeyframe(outcome.t_s, T_odom_body);
       ++summary.keyframes;
+      // The graph as it was after keyframe id - kDelayKeyframes; waits if the mapping thread is
+      // behind, so the correction depends on the data, not on timing.
+      if (correct_odometry && odometry.levelled() && id >= OdometryCorrection::kDelayKeyframes) {
+        const auto wait_start = Clock::now();
+        const std::optional<mapping::GraphSnapshot> snapshot =
+            mapping_thread.waitForSnapshot(id - OdometryCorrection::kDelayKeyframes);
+        correction_wait_s += std::chrono::duration<double>(Clock::now() - wait_start).count();
+        if (snapshot && correction.apply(*snapshot, odometry)) ++summary.odometry_corrections;
+      }
     }
   };
   // GNSS fixes are kept for the georeferencing at the end (and the IMU's absolute orientation,
@@ -351,8 +379,11 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                     "lidar_only",
                     recording_path.string(), summary.scans, summary.imu_samples));
   }
-  // The odometry as it ran online; then every pose corrected by the mapping graph.
+  // The odometry in its continuous frame, its live poses as published, then every pose corrected
+  // by the mapping graph.
   io::writeTum(options.out_dir / "trajectory_odometry.tum", trajectory);
+  io::writeTum(options.out_dir / "trajectory_online.tum", trajectory_online);
+  summary.odometry_correction_wait_s = correction_wait_s;
   const Trajectory corrected =
       mapping::correctedTrajectory(trajectory, mapper.graph(), keyframe_times_s);
   io::writeTum(options.out_dir / "trajectory.tum", corrected);

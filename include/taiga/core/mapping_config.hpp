@@ -7,6 +7,9 @@ namespace taiga {
 
 struct MappingConfig final : ConfigSection {
   bool loop_closure = true;
+  /// Feed the graph's corrections back into the running odometry: its live world frame and
+  /// local map follow the corrected keyframe poses (pipeline/odometry_correction.hpp).
+  bool correct_odometry = true;
   // Candidates (thesis Eq. 38): the nearest keyframe in space, excluding the most recent ones,
   // within a radius that grows with the path travelled since the candidate (the drift it may
   // have accumulated), so long loops still close.

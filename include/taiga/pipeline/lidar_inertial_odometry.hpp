@@ -19,6 +19,7 @@
 // reported once in ScanOutcome::world_correction, and everything so far is re-expressed with it.
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -99,6 +100,13 @@ class LidarInertialOdometry {
   }
   /// True once the world frame is levelled (or when alignment is off).
   bool levelled() const { return levelled_; }
+  /// The mapping graph corrected the keyframe poses (MappingConfig::correct_odometry): the state
+  /// is re-expressed in the corrected world frame (T_new_old; with an IMU it must keep gravity
+  /// along -z: a turn about z and a translation) and the local map's keyframes move to
+  /// `T_world_keyframe_at(t_s, T_old_keyframe)`, given in the new frame. Between scans.
+  void correctWorld(const lie::SE3& T_new_old,
+                    const std::function<lie::SE3(double t_s, const lie::SE3& T_old_keyframe)>&
+                        T_world_keyframe_at);
   const std::string& initializationNote() const { return initialization_note_; }
 
  private:

@@ -1,7 +1,8 @@
 #pragma once
-// The local map that scans are registered to: the points of the latest keyframes in the world
-// frame. Its NDT cells come from incremental voxel statistics, so adding a keyframe and dropping
-// the oldest costs only their own points (registration/voxel_statistics.hpp).
+// The local map that scans are registered to: the points of the latest keyframes, each in its
+// body frame with its pose in the world frame, so that corrected poses can move them (repose()).
+// Its NDT cells come from incremental voxel statistics, so adding a keyframe and dropping the
+// oldest costs only their own points (registration/voxel_statistics.hpp).
 //
 // The search structures (NDT target or GICP cloud, and the kd-tree for the fitness score) are
 // rebuilt after each keyframe on a background thread (15-25 ms on an OS0-128 map), while the next
@@ -11,10 +12,12 @@
 
 #include <Eigen/Core>
 #include <deque>
+#include <functional>
 #include <future>
 #include <memory>
 #include <vector>
 
+#include "taiga/lie/se3.hpp"
 #include "taiga/registration/gicp.hpp"
 #include "taiga/registration/kdtree.hpp"
 #include "taiga/registration/ndt.hpp"
@@ -38,9 +41,15 @@ class LocalMap {
   LocalMap(const LocalMap&) = delete;  // the background build refers to this object
   LocalMap& operator=(const LocalMap&) = delete;
 
-  /// Adds one keyframe's points (world frame), drops the oldest keyframe beyond max_keyframes,
-  /// and starts building the search structures in the background.
-  void addKeyframe(std::vector<Eigen::Vector3d> points_in_world);
+  /// Adds one keyframe (its time, pose and points in its body frame), drops the oldest keyframe
+  /// beyond max_keyframes, and starts building the search structures in the background.
+  void addKeyframe(double t_s, const lie::SE3& T_world_keyframe,
+                   std::vector<Eigen::Vector3d> points_in_keyframe);
+  /// Moves every keyframe to a new pose (`T_world_keyframe_at(t_s, old T_world_keyframe)`), e.g.
+  /// the mapping graph's after a loop closure, and rebuilds the search structures from them. The
+  /// next registration waits for them: the old ones are in the old world frame.
+  void repose(const std::function<lie::SE3(double t_s, const lie::SE3& T_world_keyframe)>&
+                  T_world_keyframe_at);
   /// Drops every keyframe.
   void clear();
   /// Replaces the NDT passes (coarse to fine, at least one); only while the map is empty.
@@ -71,7 +80,15 @@ class LocalMap {
   int max_keyframes_;
   Target target_;
   registration::GicpConfig gicp_config_;
-  std::deque<std::vector<Eigen::Vector3d>> keyframes_;
+  struct Keyframe {
+    double t_s = 0.0;
+    lie::SE3 T_world_keyframe;
+    std::vector<Eigen::Vector3d> points_in_keyframe;
+  };
+  /// Adds (`sign` +1) or removes (-1) a keyframe's points, in the world frame, to the statistics.
+  void account(const Keyframe& keyframe, int sign);
+
+  std::deque<Keyframe> keyframes_;
   std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
   registration::VoxelStatistics point_statistics_;  ///< one mean per point_spacing_m voxel
   SearchStructures in_use_;

@@ -3,7 +3,9 @@
 //   trajectory.tum       one pose per scan (T_world_body at the scan's end), corrected by the
 //                        mapping graph (loop closures)
 //   trajectory_imu.tum   IMU-rate poses (propagated between scans), corrected likewise
-//   trajectory_odometry.tum  the odometry's per-scan poses as published live, uncorrected
+//   trajectory_odometry.tum  the odometry's per-scan poses in its continuous frame, uncorrected
+//   trajectory_online.tum    the per-scan poses as published live: with mapping.correct_odometry
+//                        they follow the mapping graph's corrections as they come
 //   keyframes.tum        the keyframe poses optimized by the mapping graph
 //   loops.csv            every loop closure attempt: candidate, fitness, correction, verdict
 //   keyframes/           every keyframe's full deskewed scan in the body frame (NNNNNN.tkf,
@@ -32,13 +34,13 @@ namespace taiga::pipeline {
 
 struct RunOptions {
   std::filesystem::path out_dir;
-  bool write_ply = false;     ///< also map.ply (holds the map in memory while it is written)
+  bool write_ply = false;  ///< also map.ply (holds the map in memory while it is written)
   /// > 0: the map is decimated to one point per voxel across all keyframes (the point nearest
   /// each voxel's centre, mapping/map_export.hpp)
   double map_voxel_m = 0.0;
-  bool realtime = false;      ///< replay at sensor rate, dropping scans when behind
+  bool realtime = false;                 ///< replay at sensor rate, dropping scans when behind
   std::size_t realtime_queue_scans = 2;  ///< scans that may wait before the oldest is dropped
-  bool show_progress = true;  ///< a progress line on a terminal
+  bool show_progress = true;             ///< a progress line on a terminal
   /// Per-scan boxes around moving parts of the rig (io/moving_boxes.hpp); empty: none.
   std::filesystem::path moving_boxes_file;
 };
@@ -72,11 +74,15 @@ struct RunSummary {
   std::size_t lidar_inflated = 0;
   std::size_t map_points = 0;
   std::size_t loop_closures = 0;
+  /// Times the odometry's live frame and local map followed the mapping graph, and the wall time
+  /// it waited for the mapping thread (MappingConfig::correct_odometry).
+  std::size_t odometry_corrections = 0;
+  double odometry_correction_wait_s = 0.0;
   double duration_s = 0.0;  ///< recording time covered by the states
   double path_length_m = 0.0;
   double mean_ms = 0.0, median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;
-  double wall_time_s = 0.0;   ///< reading, odometry and mapping graph, keyframe files included
-  double map_export_s = 0.0;  ///< map.las (and map.ply) from keyframes/ at the end
+  double wall_time_s = 0.0;      ///< reading, odometry and mapping graph, keyframe files included
+  double map_export_s = 0.0;     ///< map.las (and map.ply) from keyframes/ at the end
   double realtime_factor = 0.0;  ///< recording duration / wall time (> 1: faster than the sensor)
   double peak_memory_mb = 0.0;
   std::string initialization;
