@@ -29,9 +29,10 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.field("max_range_m", max_range_m, "m, returns farther from the lidar are dropped");
   v.field("voxel_size_m", voxel_size_m, "m, voxel filter of the scan registered to the local map");
   static constexpr std::array<std::string_view, 3> kImuUses{"auto", "lidar_inertial", "lidar_only"};
-  v.choice("imu_use", imu_use, kImuUses,
-           "lidar_only: constant-velocity prediction and deskew, no IMU; auto: lidar_only when no IMU "
-           "reading comes within the first 2 s of scans");
+  v.choice(
+      "imu_use", imu_use, kImuUses,
+      "lidar_only: constant-velocity prediction and deskew, no IMU; auto: lidar_only when no IMU "
+      "reading comes within the first 2 s of scans");
   static constexpr std::array<std::string_view, 3> kMethods{"ndt", "d2d", "gicp"};
   v.choice("method", method, kMethods,
            "scan-to-map registration: ndt, d2d (distribution-to-distribution) or gicp");
@@ -80,8 +81,13 @@ LidarSigmas OdometryConfig::lidarSigmas(double fitness_m2, double inflation) con
   return {lidar_sigma * growth, lidar_sigma * growth, heading_rad * growth};
 }
 
+double OdometryConfig::coarsestNdtResolutionM() const {
+  return std::max(ndt_coarse_resolution_m, ndt_resolution_m);
+}
+
 std::vector<double> OdometryConfig::ndtResolutionsM() const {
-  if (ndt_coarse_resolution_m > ndt_resolution_m) return {ndt_coarse_resolution_m, ndt_resolution_m};
+  if (ndt_coarse_resolution_m > ndt_resolution_m)
+    return {ndt_coarse_resolution_m, ndt_resolution_m};
   return {ndt_resolution_m};
 }
 

@@ -50,8 +50,7 @@ LidarInertialOdometry::LidarInertialOdometry(const OdometryConfig& config, const
       rig_(rig),
       gravity_world_(0.0, 0.0, -config.imu.gravity_mps2),
       smoother_({.gravity_world = gravity_world_, .window_states = config.window_states}),
-      // The IMU predicts within centimetres: the fine cells' basin suffices (setLidarOnly()).
-      local_map_({config.ndt_resolution_m}, config.local_map_voxel_m, config.local_map_keyframes,
+      local_map_(registrationResolutionsM(), config.local_map_voxel_m, config.local_map_keyframes,
                  config.method == "gicp" ? LocalMap::Target::kGicp : LocalMap::Target::kNdt),
       levelled_(config.gravity_alignment_s <= 0.0) {
   const lie::SE3 T_lidar_body = rig_.T_body_lidar.inverse();
@@ -63,8 +62,14 @@ LidarInertialOdometry::~LidarInertialOdometry() = default;
 
 void LidarInertialOdometry::setLidarOnly(bool lidar_only) {
   lidar_only_ = lidar_only;
-  local_map_.setNdtResolutions(lidar_only ? config_.ndtResolutionsM()
-                                          : std::vector<double>{config_.ndt_resolution_m});
+  local_map_.setNdtResolutions(registrationResolutionsM());
+}
+
+std::vector<double> LidarInertialOdometry::registrationResolutionsM() const {
+  // The IMU predicts within centimetres: the fine cells' basin suffices. The constant-velocity
+  // prediction of lidar-only odometry may be off by decimetres: coarse to fine.
+  if (lidar_only_) return config_.ndtResolutionsM();
+  return {config_.ndt_resolution_m};
 }
 
 imu::ImuNoise LidarInertialOdometry::imuNoise() const {
@@ -362,7 +367,7 @@ registration::RegistrationResult LidarInertialOdometry::registerToMap(
   }
   // Points farther than a few coarse NDT cells from the map are new ground, not misalignment.
   result.fitness_m2 = registration::fitnessScore(
-      source, local_map_.kdTree(), result.T_target_source, 2.0 * config_.ndtResolutionsM().front());
+      source, local_map_.kdTree(), result.T_target_source, 2.0 * config_.coarsestNdtResolutionM());
   return result;
 }
 

@@ -48,10 +48,11 @@ struct OdometryConfig final : ConfigSection {
   double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
   int local_map_keyframes = 20;            ///< keyframes the local map holds
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
-  double lidar_sigma = 0.01;            ///< sigma_sm: m and rad (roll, pitch; heading unless set below), at good fitness
+  double lidar_sigma =
+      0.01;  ///< sigma_sm: m and rad (roll, pitch; heading unless set below), at good fitness
   double lidar_heading_sigma_rad = 0.003;  ///< heading sigma at good fitness; 0: lidar_sigma
-  double fitness_threshold_m2 = 0.3;    ///< tau_fs
-  double fitness_sigma_exponent = 2.0;  ///< theta_smsc
+  double fitness_threshold_m2 = 0.3;       ///< tau_fs
+  double fitness_sigma_exponent = 2.0;     ///< theta_smsc
   // Rejection of registrations that disagree with the IMU prediction or did not work.
   double max_fitness_m2 = 2.0;
   double max_jump_m = 0.5;
@@ -75,6 +76,8 @@ struct OdometryConfig final : ConfigSection {
   /// The NDT passes' cell edges, coarse to fine: {ndt_coarse_resolution_m, ndt_resolution_m},
   /// or {ndt_resolution_m} alone when the coarse one is 0 or not coarser.
   std::vector<double> ndtResolutionsM() const;
+  /// The coarsest of them.
+  double coarsestNdtResolutionM() const;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

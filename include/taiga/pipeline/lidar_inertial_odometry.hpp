@@ -110,6 +110,8 @@ class LidarInertialOdometry {
   const std::string& initializationNote() const { return initialization_note_; }
 
  private:
+  /// The local map's NDT passes, coarse to fine.
+  std::vector<double> registrationResolutionsM() const;
   void initialize(const io::Scan& first, const io::Scan& second);
   std::optional<ScanOutcome> addScanLidarOnly(const io::Scan& scan);
   /// The scan's returns within the range limits and outside the rig's boxes, in the lidar frame.
