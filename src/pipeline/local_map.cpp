@@ -45,28 +45,27 @@ void LocalMap::finishPendingBuild() {
   if (pending_.valid()) in_use_ = pending_.get();
 }
 
-void LocalMap::account(const Keyframe& keyframe, int sign) {
+void LocalMap::account(const Keyframe& keyframe, Change change) {
   std::vector<Eigen::Vector3d> points_in_world = keyframe.points_in_keyframe;
   for (Eigen::Vector3d& p : points_in_world) p = keyframe.T_world_keyframe * p;
-  for (registration::VoxelStatistics& statistics : ndt_statistics_) {
-    if (sign > 0)
+  // Removal subtracts exactly what adding added: the same points through the same pose.
+  auto apply = [&](registration::VoxelStatistics& statistics) {
+    if (change == Change::kAdd)
       statistics.add(points_in_world);
     else
       statistics.remove(points_in_world);
-  }
-  if (sign > 0)
-    point_statistics_.add(points_in_world);
-  else
-    point_statistics_.remove(points_in_world);
+  };
+  for (registration::VoxelStatistics& statistics : ndt_statistics_) apply(statistics);
+  apply(point_statistics_);
 }
 
 void LocalMap::addKeyframe(double t_s, const lie::SE3& T_world_keyframe,
                            std::vector<Eigen::Vector3d> points_in_keyframe) {
   finishPendingBuild();  // it reads the statistics that change now
   keyframes_.push_back({t_s, T_world_keyframe, std::move(points_in_keyframe)});
-  account(keyframes_.back(), +1);
+  account(keyframes_.back(), Change::kAdd);
   while (static_cast<int>(keyframes_.size()) > max_keyframes_) {
-    account(keyframes_.front(), -1);
+    account(keyframes_.front(), Change::kRemove);
     keyframes_.pop_front();
   }
   pending_ = std::async(std::launch::async, [this] { return build(); });
@@ -80,7 +79,7 @@ void LocalMap::repose(const std::function<lie::SE3(double t_s, const lie::SE3& T
   point_statistics_.clear();
   for (Keyframe& keyframe : keyframes_) {
     keyframe.T_world_keyframe = T_world_keyframe_at(keyframe.t_s, keyframe.T_world_keyframe);
-    account(keyframe, +1);
+    account(keyframe, Change::kAdd);
   }
   in_use_ = {};  // so that beginRegistration() waits for the structures in the new frame
   if (!keyframes_.empty()) pending_ = std::async(std::launch::async, [this] { return build(); });

@@ -98,8 +98,8 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"imu_samples", s.imu_samples},
       {"keyframes", s.keyframes},
       {"loop_closures", s.loop_closures},
-      {"odometry_corrections", {{"applied", s.odometry_corrections},
-                                {"wait_s", s.odometry_correction_wait_s}}},
+      {"odometry_corrections",
+       {{"applied", s.odometry_corrections}, {"wait_s", s.odometry_correction_wait_s}}},
       {"registration_failures", s.lidar_rejected},
       {"lidar_factors_inflated", s.lidar_inflated},
       {"map_points", s.map_points},
@@ -219,9 +219,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   // that loop closure registers stays in RAM.
   mapping::KeyframeStore keyframe_store = mapping::KeyframeStore::create(
       options.out_dir / "keyframes", {.registration_voxel_m = config.odometry.voxel_size_m});
-  // The mapping graph runs beside the odometry and corrects the keyframe poses at the end. The
-  // odometry does not wait for it, and its trajectory does not depend on it. After every
-  // keyframe it rewrites keyframes/poses.tum, so `taiga export-map` gives the map so far.
+  // The mapping graph runs beside the odometry and corrects the keyframe poses at the end. With
+  // mapping.correct_odometry the odometry follows its corrections two keyframes later (below).
+  // After every keyframe it rewrites keyframes/poses.tum, so `taiga export-map` gives the map
+  // so far.
   const bool correct_odometry = config.mapping.correct_odometry;
   mapping::MappingThread mapping_thread(
       config.mapping, config.odometry, keyframe_store,

@@ -85,8 +85,9 @@ class LocalMap {
     lie::SE3 T_world_keyframe;
     std::vector<Eigen::Vector3d> points_in_keyframe;
   };
-  /// Adds (`sign` +1) or removes (-1) a keyframe's points, in the world frame, to the statistics.
-  void account(const Keyframe& keyframe, int sign);
+  enum class Change { kAdd, kRemove };
+  /// Adds a keyframe's points, in the world frame, to the statistics, or removes them.
+  void account(const Keyframe& keyframe, Change change);
 
   std::deque<Keyframe> keyframes_;
   std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
