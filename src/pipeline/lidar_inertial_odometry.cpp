@@ -483,33 +483,6 @@ void LidarInertialOdometry::levelWorld(ScanOutcome& outcome) {
       fmt::format("; levelled after {:.1f} s by {:.2f} deg", config_.gravity_alignment_s, tilt_deg);
 }
 
-void LidarInertialOdometry::correctWorld(
-    const lie::SE3& T_new_old,
-    const std::function<lie::SE3(double t_s, const lie::SE3& T_old_keyframe)>&
-        T_world_keyframe_at) {
-  if (last_keyframe_T_world_body_)
-    last_keyframe_T_world_body_ = T_new_old * *last_keyframe_T_world_body_;
-  if (constant_velocity_)
-    constant_velocity_->T_world_body = T_new_old * constant_velocity_->T_world_body;
-  if (!lidar_only_ && smoother_.initialized()) {
-    // The latest state and its marginal covariance, re-expressed: the window before it is
-    // summarized by that marginal, as when the oldest state is marginalized.
-    backend::StateEstimate moved = smoother_.latest();
-    const lie::SO3& R_new_old = T_new_old.rotation();
-    moved.state.R_world_body = R_new_old * moved.state.R_world_body;
-    moved.state.p_world = T_new_old * moved.state.p_world;
-    moved.state.v_world = R_new_old * moved.state.v_world;
-    // Tangent [dp; dtheta; dv; dba; dbg]: dp and dv are world-frame vectors and turn with it;
-    // dtheta (body frame) and the biases do not.
-    backend::Matrix15 J = backend::Matrix15::Identity();
-    J.block<3, 3>(0, 0) = R_new_old.matrix();
-    J.block<3, 3>(6, 6) = R_new_old.matrix();
-    moved.covariance = J * moved.covariance * J.transpose();
-    smoother_.initialize(moved);
-  }
-  local_map_.repose(T_world_keyframe_at);
-}
-
 void LidarInertialOdometry::maybeAddKeyframe(ScanOutcome& outcome,
                                              const PointCloud& cloud_in_body) {
   if (last_keyframe_T_world_body_) {

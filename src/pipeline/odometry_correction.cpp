@@ -1,6 +1,5 @@
 #include "odometry_correction.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -15,26 +14,29 @@ lie::SE3 turnAboutZ(const lie::SE3& T, const Eigen::Vector3d& p_anchor) {
   return lie::SE3(R_z, T * p_anchor - R_z * p_anchor);
 }
 
+bool movedApart(const lie::SE3& a, const lie::SE3& b) {
+  const lie::SE3 delta = a.inverse() * b;
+  return delta.translation().norm() > OdometryCorrection::kMinShiftM ||
+         delta.rotation().angle() > OdometryCorrection::kMinTurnRad;
+}
+
 }  // namespace
 
 void OdometryCorrection::addKeyframe(double t_s, const lie::SE3& T_odom_keyframe) {
-  keyframe_times_s_.push_back(t_s);
   T_odom_keyframes_.push_back(T_odom_keyframe);
+  local_map_.push_back({t_s, T_odom_keyframe});
+  while (local_map_.size() > local_map_keyframes_) local_map_.pop_front();
 }
 
 void OdometryCorrection::changeOdomFrame(const lie::SE3& T_new_old) {
-  if (!T_world_odom_.matrix().isIdentity())
+  if (!T_map_odom_.matrix().isIdentity())
     throw std::logic_error("OdometryCorrection: the odom frame changed after a correction");
   for (lie::SE3& T_odom_keyframe : T_odom_keyframes_) T_odom_keyframe = T_new_old * T_odom_keyframe;
+  for (LocalMapKeyframe& keyframe : local_map_)
+    keyframe.T_odom_keyframe = T_new_old * keyframe.T_odom_keyframe;
 }
 
-std::optional<std::size_t> OdometryCorrection::keyframeAt(double t_s) const {
-  const auto found = std::lower_bound(keyframe_times_s_.begin(), keyframe_times_s_.end(), t_s);
-  if (found == keyframe_times_s_.end() || *found != t_s) return std::nullopt;
-  return static_cast<std::size_t>(found - keyframe_times_s_.begin());
-}
-
-bool OdometryCorrection::apply(const mapping::GraphSnapshot& snapshot,
+bool OdometryCorrection::apply(const mapping::GraphSnapshot& snapshot, bool keep_gravity,
                                LidarInertialOdometry& odometry) {
   const std::size_t k = snapshot.keyframe;
   const std::size_t count = snapshot.poses_T_world_body.size();
@@ -42,23 +44,29 @@ bool OdometryCorrection::apply(const mapping::GraphSnapshot& snapshot,
     throw std::logic_error("OdometryCorrection: a snapshot of unknown keyframes");
   const lie::SE3& T_graph_k = snapshot.poses_T_world_body.back();
   const lie::SE3& T_odom_k = T_odom_keyframes_[k];
-  lie::SE3 T_world_odom = T_graph_k * T_odom_k.inverse();
-  if (!odometry.lidarOnly()) T_world_odom = turnAboutZ(T_world_odom, T_odom_k.translation());
-  const lie::SE3 T_new_old = T_world_odom * T_world_odom_.inverse();
-  const lie::Vector6 change = T_new_old.Log();
-  if (T_new_old.translation().norm() < kMinShiftM && change.tail<3>().norm() < kMinTurnRad)
-    return false;
-  // Keyframes up to k in the graph's shape, anchored at keyframe k in the new live frame; the
-  // later ones (and any not found) as the odometry made them.
-  const lie::SE3 T_world_graph = T_world_odom * T_odom_k * T_graph_k.inverse();
-  const std::size_t first = k + 1 - count;
-  odometry.correctWorld(T_new_old, [&](double t_s, const lie::SE3& T_old_keyframe) {
-    const std::optional<std::size_t> id = keyframeAt(t_s);
-    if (!id) return T_new_old * T_old_keyframe;
-    if (*id >= first && *id <= k) return T_world_graph * snapshot.poses_T_world_body[*id - first];
-    return T_world_odom * T_odom_keyframes_[*id];
+  T_map_odom_ = T_graph_k * T_odom_k.inverse();
+  if (keep_gravity) T_map_odom_ = turnAboutZ(T_map_odom_, T_odom_k.translation());
+
+  // The local map's keyframes up to k in the graph's shape, anchored at keyframe k.
+  const lie::SE3 T_odom_graph = T_odom_k * T_graph_k.inverse();
+  const std::size_t first_id = k + 1 - count;
+  const std::size_t local_first_id = T_odom_keyframes_.size() - local_map_.size();
+  bool bent = false;
+  std::vector<lie::SE3> reshaped;
+  for (std::size_t i = 0; i < local_map_.size(); ++i) {
+    const std::size_t id = local_first_id + i;
+    reshaped.push_back(id >= first_id && id <= k
+                           ? T_odom_graph * snapshot.poses_T_world_body[id - first_id]
+                           : local_map_[i].T_odom_keyframe);
+    bent = bent || movedApart(reshaped.back(), local_map_[i].T_odom_keyframe);
+  }
+  if (!bent) return false;
+  for (std::size_t i = 0; i < local_map_.size(); ++i) local_map_[i].T_odom_keyframe = reshaped[i];
+  odometry.reposeLocalMap([&](double t_s, const lie::SE3& T_old_keyframe) {
+    for (const LocalMapKeyframe& keyframe : local_map_)
+      if (keyframe.t_s == t_s) return keyframe.T_odom_keyframe;
+    return T_old_keyframe;  // a keyframe the run did not store: as it is
   });
-  T_world_odom_ = T_world_odom;
   return true;
 }
 

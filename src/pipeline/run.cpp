@@ -99,7 +99,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"keyframes", s.keyframes},
       {"loop_closures", s.loop_closures},
       {"odometry_corrections",
-       {{"applied", s.odometry_corrections}, {"wait_s", s.odometry_correction_wait_s}}},
+       {{"local_map_rebuilds", s.local_map_rebuilds}, {"wait_s", s.odometry_correction_wait_s}}},
       {"registration_failures", s.lidar_rejected},
       {"lidar_factors_inflated", s.lidar_inflated},
       {"map_points", s.map_points},
@@ -220,7 +220,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   mapping::KeyframeStore keyframe_store = mapping::KeyframeStore::create(
       options.out_dir / "keyframes", {.registration_voxel_m = config.odometry.voxel_size_m});
   // The mapping graph runs beside the odometry and corrects the keyframe poses at the end. With
-  // mapping.correct_odometry the odometry follows its corrections two keyframes later (below).
+  // mapping.correct_odometry the live poses follow its corrections two keyframes later (below).
   // After every keyframe it rewrites keyframes/poses.tum, so `taiga export-map` gives the map
   // so far.
   const bool correct_odometry = config.mapping.correct_odometry;
@@ -244,10 +244,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
                     options.show_progress && isatty(fileno(stderr)));
   const auto wall_start = Clock::now();
 
-  // The graph's corrections fed back into the odometry (odometry_correction.hpp). The odometry's
-  // live poses go to trajectory_online.tum; every other output is in the continuous odom frame
-  // the mapping graph works in (T_odom_body = T_world_odom^-1 * T_world_body).
-  OdometryCorrection correction;
+  // The graph's corrections fed back into the odometry (odometry_correction.hpp): the live poses
+  // are published in the graph's map frame (trajectory_online.tum); every other output is in the
+  // odometry's own continuous frame, which the graph corrects at the end.
+  OdometryCorrection correction(static_cast<std::size_t>(config.odometry.local_map_keyframes));
   Trajectory trajectory_online;
   double correction_wait_s = 0.0;
   auto consume = [&](const ScanOutcome& outcome) {
@@ -262,19 +262,17 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       mapping_thread.changeWorldFrame(T_new_old);
       if (online_georef) online_georef->changeWorldFrame(T_new_old);
     }
-    appendIfLater(trajectory_online, outcome.t_s, outcome.T_world_body);
-    const lie::SE3 T_odom_world = correction.T_world_odom().inverse();
-    const lie::SE3 T_odom_body = T_odom_world * outcome.T_world_body;
+    appendIfLater(trajectory_online, outcome.t_s, correction.T_map_odom() * outcome.T_world_body);
     if (online_georef) {
-      online_georef->addPose(outcome.t_s, T_odom_body);
-      if (auto grid = online_georef->toGrid(outcome.t_s, T_odom_body))
+      online_georef->addPose(outcome.t_s, outcome.T_world_body);
+      if (auto grid = online_georef->toGrid(outcome.t_s, outcome.T_world_body))
         online_poses.push_back(
             {*grid, online_georef->estimate()->fit.sigma, online_georef->estimate()->fixes});
     }
-    appendIfLater(trajectory, outcome.t_s, T_odom_body);
+    appendIfLater(trajectory, outcome.t_s, outcome.T_world_body);
     for (const StampedPose& p : outcome.imu_rate_poses)
-      appendIfLater(trajectory_imu, p.t_s, T_odom_world * p.pose);
-    appendIfLater(trajectory_imu, outcome.t_s, T_odom_body);
+      appendIfLater(trajectory_imu, p.t_s, p.pose);
+    appendIfLater(trajectory_imu, outcome.t_s, outcome.T_world_body);
     summary.lidar_rejected += outcome.lidar == LidarFactor::kRejected;
     summary.lidar_inflated += outcome.lidar == LidarFactor::kInflated;
     totals_ms.push_back(outcome.timing.total_ms);
@@ -291,10 +289,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
         (keyframe_store.empty() ||
          outcome.t_s > keyframe_store.info(keyframe_store.size() - 1).t_s)) {
       const std::uint64_t id =
-          keyframe_store.add(outcome.t_s, T_odom_body, *outcome.keyframe_cloud_in_body);
-      mapping_thread.addKeyframe(id, outcome.t_s, T_odom_body);
+          keyframe_store.add(outcome.t_s, outcome.T_world_body, *outcome.keyframe_cloud_in_body);
+      mapping_thread.addKeyframe(id, outcome.t_s, outcome.T_world_body);
       keyframe_times_s.push_back(outcome.t_s);
-      correction.addKeyframe(outcome.t_s, T_odom_body);
+      correction.addKeyframe(outcome.t_s, outcome.T_world_body);
       ++summary.keyframes;
       // The graph as it was after keyframe id - kDelayKeyframes; waits if the mapping thread is
       // behind, so the correction depends on the data, not on timing.
@@ -303,7 +301,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
         const std::optional<mapping::GraphSnapshot> snapshot =
             mapping_thread.waitForSnapshot(id - OdometryCorrection::kDelayKeyframes);
         correction_wait_s += std::chrono::duration<double>(Clock::now() - wait_start).count();
-        if (snapshot && correction.apply(*snapshot, odometry)) ++summary.odometry_corrections;
+        if (snapshot && correction.apply(*snapshot, !odometry.lidarOnly(), odometry))
+          ++summary.local_map_rebuilds;
       }
     }
   };

@@ -7,7 +7,7 @@ namespace taiga {
 
 struct MappingConfig final : ConfigSection {
   bool loop_closure = true;
-  /// Feed the graph's corrections back into the running odometry: its live world frame and
+  /// Feed the graph's corrections back into the running odometry: its published poses and its
   /// local map follow the corrected keyframe poses (pipeline/odometry_correction.hpp).
   bool correct_odometry = true;
   // Candidates (thesis Eq. 38): the nearest keyframe in space, excluding the most recent ones,

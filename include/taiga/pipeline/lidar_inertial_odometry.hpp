@@ -100,13 +100,13 @@ class LidarInertialOdometry {
   }
   /// True once the world frame is levelled (or when alignment is off).
   bool levelled() const { return levelled_; }
-  /// The mapping graph corrected the keyframe poses (MappingConfig::correct_odometry): the state
-  /// is re-expressed in the corrected world frame (T_new_old; with an IMU it must keep gravity
-  /// along -z: a turn about z and a translation) and the local map's keyframes move to
-  /// `T_world_keyframe_at(t_s, T_old_keyframe)`, given in the new frame. Between scans.
-  void correctWorld(const lie::SE3& T_new_old,
-                    const std::function<lie::SE3(double t_s, const lie::SE3& T_old_keyframe)>&
-                        T_world_keyframe_at);
+  /// Moves the local map's keyframes to `T_world_keyframe_at(t_s, T_world_keyframe)` and
+  /// rebuilds it, e.g. in the shape the mapping graph gave them after a loop closure
+  /// (MappingConfig::correct_odometry). The state stays. Between scans.
+  void reposeLocalMap(const std::function<lie::SE3(double t_s, const lie::SE3& T_world_keyframe)>&
+                          T_world_keyframe_at) {
+    local_map_.repose(T_world_keyframe_at);
+  }
   const std::string& initializationNote() const { return initialization_note_; }
 
  private:

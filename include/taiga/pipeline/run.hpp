@@ -5,7 +5,7 @@
 //   trajectory_imu.tum   IMU-rate poses (propagated between scans), corrected likewise
 //   trajectory_odometry.tum  the odometry's per-scan poses in its continuous frame, uncorrected
 //   trajectory_online.tum    the per-scan poses as published live: with mapping.correct_odometry
-//                        they follow the mapping graph's corrections as they come
+//                        in the mapping graph's frame, its corrections taken as they come
 //   keyframes.tum        the keyframe poses optimized by the mapping graph
 //   loops.csv            every loop closure attempt: candidate, fitness, correction, verdict
 //   keyframes/           every keyframe's full deskewed scan in the body frame (NNNNNN.tkf,
@@ -74,9 +74,9 @@ struct RunSummary {
   std::size_t lidar_inflated = 0;
   std::size_t map_points = 0;
   std::size_t loop_closures = 0;
-  /// Times the odometry's live frame and local map followed the mapping graph, and the wall time
-  /// it waited for the mapping thread (MappingConfig::correct_odometry).
-  std::size_t odometry_corrections = 0;
+  /// Times the odometry rebuilt its local map in the shape the mapping graph gave it, and the
+  /// wall time it waited for the mapping thread (MappingConfig::correct_odometry).
+  std::size_t local_map_rebuilds = 0;
   double odometry_correction_wait_s = 0.0;
   double duration_s = 0.0;  ///< recording time covered by the states
   double path_length_m = 0.0;
