@@ -1,5 +1,8 @@
 // taiga run: lidar-inertial odometry over a recording, with the outputs of pipeline/run.hpp.
 #include <fmt/format.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <memory>
 
@@ -19,7 +22,20 @@ struct RunOptions {
   std::string moving_boxes;
 };
 
+// One malloc arena for the whole run. Each loop closure attempt allocates tens of MB for a
+// moment (the candidate's submap, its NDT cells); in a thread arena of its own glibc keeps that
+// high-water mark, and the run's resident memory kept growing with every attempt (0.04-0.13 MB
+// per keyframe on handheld-long). With one arena the freed blocks are reused by every thread:
+// handheld-long (900 s, 64 beams) stays flat, at the same outputs and speed (bench/BENCHMARK.md,
+// "Session 16").
+void useOneMallocArena() {
+#ifdef __GLIBC__
+  mallopt(M_ARENA_MAX, 1);
+#endif
+}
+
 int run(const RunOptions& options) {
+  useOneMallocArena();
   SystemConfig config = loadConfig(options.config);
   if (!options.registration.empty()) config.odometry.method = options.registration;
   validateAll(config);
@@ -40,18 +56,20 @@ int run(const RunOptions& options) {
   fmt::print("mapping    {} loop closures (loops.csv); map exported in {:.1f} s after the run\n",
              s.loop_closures, s.map_export_s);
   if (s.realtime) {
-    fmt::print("realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "
-               "{:.1f} ms max from delivery to pose\n",
-               s.realtime->dropped_scans, s.realtime->latency_p50_ms, s.realtime->latency_p95_ms,
-               s.realtime->latency_max_ms);
+    fmt::print(
+        "realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "
+        "{:.1f} ms max from delivery to pose\n",
+        s.realtime->dropped_scans, s.realtime->latency_p50_ms, s.realtime->latency_p95_ms,
+        s.realtime->latency_max_ms);
   }
   if (s.georef) {
     if (s.georef->skipped.empty()) {
-      fmt::print("georef     {} of {} GNSS fixes ({}), residual {:.2f} m horizontal; 1-sigma {:.2f} m "
-                 "east, {:.2f} m north, {:.2f} deg yaw; EPSG:{} in georef/\n",
-                 s.georef->inliers, s.georef->fixes, s.georef->method, s.georef->horizontal_rms_m,
-                 s.georef->sigma[0], s.georef->sigma[1], s.georef->sigma[5] * 57.29577951308232,
-                 s.georef->epsg);
+      fmt::print(
+          "georef     {} of {} GNSS fixes ({}), residual {:.2f} m horizontal; 1-sigma {:.2f} m "
+          "east, {:.2f} m north, {:.2f} deg yaw; EPSG:{} in georef/\n",
+          s.georef->inliers, s.georef->fixes, s.georef->method, s.georef->horizontal_rms_m,
+          s.georef->sigma[0], s.georef->sigma[1], s.georef->sigma[5] * 57.29577951308232,
+          s.georef->epsg);
     } else {
       fmt::print("georef     not georeferenced: {}\n", s.georef->skipped);
     }

@@ -22,10 +22,10 @@ std::optional<LoopCandidate> findLoopCandidate(const PoseGraph& graph, std::size
   const Eigen::Vector3d& p_current = graph.pose(current).translation();
   std::optional<LoopCandidate> best;
   for (std::size_t k = 0; k + excluded <= current; ++k) {
-    const double radius_m =
-        std::min(config.loop_search_radius_m + config.loop_radius_growth_m_per_m *
-                                                   (graph.pathLength(current) - graph.pathLength(k)),
-                 config.loop_max_search_radius_m);
+    const double radius_m = std::min(
+        config.loop_search_radius_m +
+            config.loop_radius_growth_m_per_m * (graph.pathLength(current) - graph.pathLength(k)),
+        config.loop_max_search_radius_m);
     const double distance_m = (graph.pose(k).translation() - p_current).norm();
     if (distance_m <= radius_m && (!best || distance_m < best->distance_m))
       best = LoopCandidate{k, distance_m, radius_m};
@@ -46,10 +46,19 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
       std::min(candidate.keyframe + half,
                current - static_cast<std::size_t>(config.loop_exclude_recent_keyframes));
   const lie::SE3 T_candidate_world = graph.pose(candidate.keyframe).inverse();
+  std::vector<std::shared_ptr<const PointCloud>> clouds;
+  std::size_t submap_points = 0;
+  for (std::size_t k = first; k <= last; ++k) {
+    clouds.push_back(store.registrationCloud(k));
+    submap_points += clouds.back()->size();
+  }
+  // Sized once: grown by doubling it would leave freed blocks of up to twice its size behind in
+  // the mapping thread's heap at every attempt.
   std::vector<Eigen::Vector3d> submap_in_candidate;
+  submap_in_candidate.reserve(submap_points);
   for (std::size_t k = first; k <= last; ++k) {
     const lie::SE3 T_candidate_k = T_candidate_world * graph.pose(k);
-    for (const Eigen::Vector3d& p_k : store.registrationCloud(k)->positions)
+    for (const Eigen::Vector3d& p_k : clouds[k - first]->positions)
       submap_in_candidate.push_back(T_candidate_k * p_k);
   }
 
@@ -64,9 +73,8 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
       resolutions_m.end() - 1);
   registration_config.ndt.search = registration::NeighbourSearch::kDirect7;
   const lie::SE3 guess_T_candidate_current = T_candidate_world * graph.pose(current);
-  attempt.registration = registration::registerClouds(source->positions, submap_in_candidate,
-                                                      guess_T_candidate_current,
-                                                      registration_config);
+  attempt.registration = registration::registerClouds(
+      source->positions, submap_in_candidate, guess_T_candidate_current, registration_config);
   const registration::RegistrationResult& r = attempt.registration;
   const lie::Vector6 correction = (guess_T_candidate_current.inverse() * r.T_target_source).Log();
   attempt.correction_m = correction.head<3>().norm();
@@ -75,8 +83,8 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   if (!r.converged) {
     attempt.note = "registration did not converge: " + r.reason;
   } else if (!(r.fitness_m2 <= config.loop_max_fitness_m2)) {
-    attempt.note = fmt::format("fitness {:.3f} m^2 above {:.3f}", r.fitness_m2,
-                               config.loop_max_fitness_m2);
+    attempt.note =
+        fmt::format("fitness {:.3f} m^2 above {:.3f}", r.fitness_m2, config.loop_max_fitness_m2);
   } else if (attempt.correction_m > candidate.search_radius_m ||
              attempt.correction_deg > config.loop_max_rotation_deg) {
     attempt.note = fmt::format("correction {:.2f} m / {:.2f} deg beyond {:.2f} m / {:.1f} deg",
