@@ -2,7 +2,8 @@
 // The mapping back end of thesis 3.1.2: keyframes from the odometry enter the pose graph, loop
 // closures are searched at most once per loop_min_interval_s of recording time and kept when
 // they verify (loop_closure.hpp) and agree with the graph (the chi^2 of the cost they add).
-// MappingThread runs it beside the odometry, so the odometry never waits for it. With
+// MappingThread runs it beside the odometry; the odometry waits for it only to take a graph
+// snapshot two keyframes late (waitForSnapshot, pipeline/odometry_correction.hpp). With
 // gnss_fusion on, GNSS fixes enter the graph too (gnss_fusion.hpp).
 
 #include <condition_variable>
