@@ -56,6 +56,11 @@ SO3::SO3(const Eigen::Quaterniond& q) : q_(q) {
 
 SO3 SO3::fromMatrix(const Matrix3& R) { return SO3(Eigen::Quaterniond(R)); }
 
+double SO3::yaw() const {
+  const Matrix3 R = matrix();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+
 SO3 SO3::fromAxisAngle(const Vector3& axis, double angle_rad) {
   return Exp(axis.normalized() * angle_rad);
 }

@@ -85,6 +85,12 @@ TEST(SO3, RollPitchYawIsExtrinsicXYZ) {
   EXPECT_TRUE((SO3::fromRollPitchYaw(0, 0, kPi / 2) * Vector3::UnitX()).isApprox(Vector3::UnitY()));
 }
 
+TEST(SO3, YawIsTheHeadingOfRollPitchYaw) {
+  EXPECT_NEAR(SO3::fromRollPitchYaw(0.1, -0.4, 2.0).yaw(), 2.0, 1e-12);
+  EXPECT_NEAR(SO3::fromRollPitchYaw(-0.3, 0.2, -2.5).yaw(), -2.5, 1e-12);
+  EXPECT_NEAR(SO3::fromRollPitchYaw(0.0, 0.0, 0.0).yaw(), 0.0, 1e-15);
+}
+
 TEST(SO3, FromMatrixProjectsANoisyMatrix) {
   const SO3 R = SO3::fromAxisAngle(Vector3(1, 2, 3), 0.7);
   const Matrix3 noisy = R.matrix() + 1e-7 * Matrix3::Ones();

@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <span>
 
+#include "taiga/core/percentile.hpp"
+
 namespace taiga::eval {
 
 struct ErrorStatistics {
@@ -23,9 +25,6 @@ struct ErrorStatistics {
 /// of `values`, so the same input gives the same bits.
 ErrorStatistics computeStatistics(std::span<const double> values);
 
-/// The p-th percentile (p in [0, 100]) as numpy.percentile with its default linear method:
-/// rank r = p / 100 * (n - 1) into the sorted values, interpolated between floor(r) and ceil(r).
-/// NaN when `values` is empty.
-double percentile(std::span<const double> values, double p);
+using taiga::percentile;  // core/percentile.hpp
 
 }  // namespace taiga::eval

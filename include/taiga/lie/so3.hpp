@@ -78,6 +78,9 @@ class SO3 {
   const Eigen::Quaterniond& quaternion() const { return q_; }
   /// Rotation angle in [0, pi].
   double angle() const { return Log().norm(); }
+  /// The heading: the angle about z of the rotated x axis, atan2(R(1,0), R(0,0)), in (-pi, pi].
+  /// The yaw of fromRollPitchYaw when |pitch| < 90 deg.
+  double yaw() const;
 
  private:
   Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
