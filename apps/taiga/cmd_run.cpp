@@ -47,7 +47,7 @@ int run(const RunOptions& options) {
                                                         .moving_boxes_file = options.moving_boxes});
   fmt::print("scans      {} read, {} processed; {} IMU samples; {:.1f} s, {:.1f} m of path\n",
              s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
-  fmt::print("lidar      {} registrations rejected, {} inflated; {} keyframes, {} map points\n",
+  fmt::print("lidar      lidar factors {} rejected, {} inflated; {} keyframes, {} map points\n",
              s.lidar_rejected, s.lidar_inflated, s.keyframes, s.map_points);
   fmt::print(
       "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {:.2f}x real time; peak "

@@ -93,7 +93,7 @@ bool GnssFusion::afterKeyframe(PoseGraph& graph, const std::vector<double>& keyf
 
 void GnssFusion::tryStart(PoseGraph& graph) {
   if (attached_.size() < static_cast<std::size_t>(config_.gnss_min_fixes)) return;
-  // Antenna positions at the current poses (the world frame may have been levelled since the
+  // Antenna positions at the current poses (loop closures may have moved the keyframes since the
   // fixes were attached).
   std::vector<georef::AssociatedFix> pairs;
   for (const Attached& attached : attached_) {
@@ -113,7 +113,7 @@ void GnssFusion::tryStart(PoseGraph& graph) {
   options.error_correlation_time_s = config_.gnss_correlation_time_s;
   try {
     const georef::GeorefFit fit = georef::fitRobust(pairs, options);
-    graph.setEnuWorld(fit.T_enu_world);
+    graph.setEnuMap(fit.T_enu_world);
     started_ = true;
     logger().debug("GNSS fusion starts with {} fixes over {:.1f} m", pairs.size(), spread_m);
   } catch (const InputError& error) {
@@ -132,7 +132,7 @@ GnssFusionReport GnssFusion::report(const PoseGraph& graph) const {
   GnssFusionReport report = counts_;
   report.waiting = attached_.size();
   report.enu_origin = origin_;
-  report.T_enu_world = graph.enuWorld();
+  report.T_enu_map = graph.enuMap();
   const std::vector<double> whitened = graph.gnssWhitenedResiduals();
   report.down_weighted = static_cast<std::size_t>(std::count_if(
       whitened.begin(), whitened.end(),

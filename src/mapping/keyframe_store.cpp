@@ -131,7 +131,7 @@ KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStor
                                    poses_path.string(), poses.size()));
     KeyframeInfo info;
     info.id = id;
-    info.T_world_body = poses[id].pose;
+    info.T_map_body = poses[id].pose;
     const KeyframeFileHeader header = readKeyframeHeader(path);
     if (header.id != id || header.t_s != poses[id].t_s) {
       throw InputError(fmt::format(
@@ -145,7 +145,7 @@ KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStor
   return store;
 }
 
-std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_world_body,
+std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_odom_body,
                                  const PointCloud& cloud_in_body) {
   std::uint64_t id = 0;
   {
@@ -158,7 +158,7 @@ std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_world_body,
   // The slow parts (file, voxel filter) outside the lock: readers of other keyframes go on.
   writeKeyframeFile(keyframePath(id), id, t_s, cloud_in_body);
   KeyframeInfo info{
-      .id = id, .t_s = t_s, .T_world_body = T_world_body, .point_count = cloud_in_body.size()};
+      .id = id, .t_s = t_s, .T_map_body = T_odom_body, .point_count = cloud_in_body.size()};
   if (impl_->options.registration_voxel_m > 0.0) {
     // The newest keyframe is the one loop closure asks for next: cache its copy now, from the
     // scan at hand, rather than read the file back.
@@ -227,41 +227,41 @@ KeyframeInfo KeyframeStore::info(std::uint64_t id) const {
   return impl_->at(id);
 }
 
-lie::SE3 KeyframeStore::pose(std::uint64_t id) const { return info(id).T_world_body; }
+lie::SE3 KeyframeStore::pose(std::uint64_t id) const { return info(id).T_map_body; }
 
 std::vector<lie::SE3> KeyframeStore::poses() const {
   const std::lock_guard lock(impl_->mutex);
   std::vector<lie::SE3> out;
   out.reserve(impl_->infos.size());
-  for (const KeyframeInfo& info : impl_->infos) out.push_back(info.T_world_body);
+  for (const KeyframeInfo& info : impl_->infos) out.push_back(info.T_map_body);
   return out;
 }
 
 Trajectory KeyframeStore::trajectory() const {
   const std::lock_guard lock(impl_->mutex);
   Trajectory out;
-  for (const KeyframeInfo& info : impl_->infos) out.append(info.t_s, info.T_world_body);
+  for (const KeyframeInfo& info : impl_->infos) out.append(info.t_s, info.T_map_body);
   return out;
 }
 
-void KeyframeStore::setPoses(const std::vector<lie::SE3>& poses_T_world_body) {
+void KeyframeStore::setPoses(const std::vector<lie::SE3>& poses_T_map_body) {
   const std::lock_guard lock(impl_->mutex);
-  if (poses_T_world_body.size() != impl_->infos.size())
+  if (poses_T_map_body.size() != impl_->infos.size())
     throw std::invalid_argument(fmt::format("KeyframeStore::setPoses: {} poses for {} keyframes",
-                                            poses_T_world_body.size(), impl_->infos.size()));
-  for (std::size_t k = 0; k < poses_T_world_body.size(); ++k)
-    impl_->infos[k].T_world_body = poses_T_world_body[k];
+                                            poses_T_map_body.size(), impl_->infos.size()));
+  for (std::size_t k = 0; k < poses_T_map_body.size(); ++k)
+    impl_->infos[k].T_map_body = poses_T_map_body[k];
 }
 
 void KeyframeStore::writePoses() const { writePoses(trajectory()); }
 
-void KeyframeStore::writePoses(const Trajectory& poses_T_world_body) const {
-  if (poses_T_world_body.size() > size())
+void KeyframeStore::writePoses(const Trajectory& poses_T_map_body) const {
+  if (poses_T_map_body.size() > size())
     throw std::invalid_argument(fmt::format("KeyframeStore::writePoses: {} poses for {} keyframes",
-                                            poses_T_world_body.size(), size()));
+                                            poses_T_map_body.size(), size()));
   const std::filesystem::path path = impl_->dir / kPosesFile;
   const std::filesystem::path temporary = impl_->dir / (std::string(kPosesFile) + ".tmp");
-  io::writeTum(temporary, poses_T_world_body);
+  io::writeTum(temporary, poses_T_map_body);
   std::error_code ec;
   std::filesystem::rename(temporary, path, ec);
   if (ec) throw InputError(fmt::format("{}: cannot write: {}", path.string(), ec.message()));

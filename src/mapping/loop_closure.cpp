@@ -4,17 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/registration/registration.hpp"
 
 namespace taiga::mapping {
-namespace {
-
-constexpr double kDegToRad = std::numbers::pi / 180.0;
-
-}  // namespace
-
 std::optional<LoopCandidate> findLoopCandidate(const PoseGraph& graph, std::size_t current,
                                                const MappingConfig& config) {
   const auto excluded = static_cast<std::size_t>(config.loop_exclude_recent_keyframes);
@@ -45,7 +39,7 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   const std::size_t last =
       std::min(candidate.keyframe + half,
                current - static_cast<std::size_t>(config.loop_exclude_recent_keyframes));
-  const lie::SE3 T_candidate_world = graph.pose(candidate.keyframe).inverse();
+  const lie::SE3 T_candidate_map = graph.pose(candidate.keyframe).inverse();
   std::vector<std::shared_ptr<const PointCloud>> clouds;
   std::size_t submap_points = 0;
   for (std::size_t k = first; k <= last; ++k) {
@@ -57,28 +51,27 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   std::vector<Eigen::Vector3d> submap_in_candidate;
   submap_in_candidate.reserve(submap_points);
   for (std::size_t k = first; k <= last; ++k) {
-    const lie::SE3 T_candidate_k = T_candidate_world * graph.pose(k);
+    const lie::SE3 T_candidate_k = T_candidate_map * graph.pose(k);
     for (const Eigen::Vector3d& p_k : clouds[k - first]->positions)
       submap_in_candidate.push_back(T_candidate_k * p_k);
   }
 
-  registration::RegistrationConfig registration_config;
-  // The odometry's passes, after one at 3x its coarsest cells: the guess may be off by the drift
-  // since the candidate, and a coarser pass widens the basin.
-  const std::vector<double> resolutions_m = odometry.ndtResolutionsM();
-  registration_config.ndt.resolution_m = resolutions_m.back();
-  registration_config.ndt.coarse_resolutions_m = {3.0 * resolutions_m.front()};
-  registration_config.ndt.coarse_resolutions_m.insert(
-      registration_config.ndt.coarse_resolutions_m.end(), resolutions_m.begin(),
-      resolutions_m.end() - 1);
+  // The odometry's NDT passes (registrationConfigFor), after one at 3x its coarsest cells, all
+  // neighbouring cells scored: the guess may be off by the drift since the candidate, and a
+  // coarser pass widens the basin. NDT whatever the odometry's method, for that coarse pass.
+  registration::RegistrationConfig registration_config = registration::registrationConfigFor(odometry);
+  registration_config.method = registration::Method::kNdt;
+  std::vector<double>& coarse_m = registration_config.ndt.coarse_resolutions_m;
+  const double coarsest_m = coarse_m.empty() ? registration_config.ndt.resolution_m : coarse_m.front();
+  coarse_m.insert(coarse_m.begin(), 3.0 * coarsest_m);
   registration_config.ndt.search = registration::NeighbourSearch::kDirect7;
-  const lie::SE3 guess_T_candidate_current = T_candidate_world * graph.pose(current);
+  const lie::SE3 guess_T_candidate_current = T_candidate_map * graph.pose(current);
   attempt.registration = registration::registerClouds(
       source->positions, submap_in_candidate, guess_T_candidate_current, registration_config);
   const registration::RegistrationResult& r = attempt.registration;
   const lie::Vector6 correction = (guess_T_candidate_current.inverse() * r.T_target_source).Log();
   attempt.correction_m = correction.head<3>().norm();
-  attempt.correction_deg = correction.tail<3>().norm() / kDegToRad;
+  attempt.correction_deg = correction.tail<3>().norm() / kRadPerDeg;
 
   if (!r.converged) {
     attempt.note = "registration did not converge: " + r.reason;

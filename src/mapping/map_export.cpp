@@ -133,11 +133,11 @@ void appendVoxelPoints(MapSink& sink, std::vector<VoxelPoint> points, bool has_t
 }  // namespace
 
 MapExportSummary exportMap(const KeyframeStore& store,
-                           const std::vector<lie::SE3>& poses_T_world_body,
+                           const std::vector<lie::SE3>& poses_T_map_body,
                            const std::filesystem::path& las_path, const MapExportOptions& options) {
-  if (poses_T_world_body.size() != store.size())
+  if (poses_T_map_body.size() != store.size())
     throw std::invalid_argument(fmt::format("exportMap: {} poses for {} keyframes",
-                                            poses_T_world_body.size(), store.size()));
+                                            poses_T_map_body.size(), store.size()));
   if (!(options.voxel_m >= 0.0) || !std::isfinite(options.voxel_m))
     throw InputError(fmt::format("--map-voxel {}: expected a voxel size >= 0 m", options.voxel_m));
 
@@ -149,7 +149,7 @@ MapExportSummary exportMap(const KeyframeStore& store,
   for (std::uint64_t id = 0; id < store.size(); ++id) {
     const PointCloud cloud_out =
         toOutputFrame(store.load(id),
-                      options.T_out_world * Eigen::Affine3d(poses_T_world_body[id].matrix()));
+                      options.T_out_map * Eigen::Affine3d(poses_T_map_body[id].matrix()));
     summary.points_read += cloud_out.size();
     ++summary.keyframes;
     if (!grid) {

@@ -76,8 +76,7 @@ void Mapper::tryLoopClosure(std::size_t current, double t_s) {
 MappingThread::MappingThread(const MappingConfig& config, const OdometryConfig& odometry,
                              const KeyframeStore& store, MappingThreadOptions options)
     : mapper_(config, odometry, store),
-      store_(store),
-      options_(options),
+      options_(std::move(options)),
       worker_([this] { work(); }) {}
 
 MappingThread::~MappingThread() {
@@ -92,8 +91,6 @@ MappingThread::~MappingThread() {
 void MappingThread::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body) {
   push(KeyframeMessage{id, t_s, T_odom_body});
 }
-
-void MappingThread::changeWorldFrame(const lie::SE3& T_new_old) { push(T_new_old); }
 
 void MappingThread::addGnssFix(const GnssFix& fix) { push(fix); }
 
@@ -118,10 +115,8 @@ void MappingThread::work() {
       if (const auto* keyframe = std::get_if<KeyframeMessage>(&message)) {
         mapper_.addKeyframe(keyframe->id, keyframe->t_s, keyframe->T_odom_body);
         publish(keyframe->id);
-      } else if (const auto* fix = std::get_if<GnssFix>(&message)) {
-        mapper_.addGnssFix(*fix);
       } else {
-        mapper_.changeWorldFrame(std::get<lie::SE3>(message));
+        mapper_.addGnssFix(std::get<GnssFix>(message));
       }
     } catch (...) {
       lock.lock();
@@ -134,13 +129,13 @@ void MappingThread::work() {
 }
 
 void MappingThread::publish(std::size_t id) {
-  if (options_.write_live_poses) store_.writePoses(mapper_.keyframeTrajectory());
+  if (options_.after_keyframe) options_.after_keyframe(mapper_);
   if (options_.snapshot_keyframes == 0) return;
   const std::vector<lie::SE3>& poses = mapper_.graph().poses();
   const std::size_t count = std::min(options_.snapshot_keyframes, poses.size());
   GraphSnapshot snapshot{
       .keyframe = id,
-      .poses_T_world_body = std::vector<lie::SE3>(poses.end() - count, poses.end())};
+      .poses_T_map_body = std::vector<lie::SE3>(poses.end() - count, poses.end())};
   {
     const std::lock_guard lock(mutex_);
     snapshots_.push_back(std::move(snapshot));

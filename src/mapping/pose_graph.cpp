@@ -48,21 +48,15 @@ RelativePose PoseGraph::odometryBetween(std::size_t from, std::size_t to) const 
   return {from, to, T_from_to, variances.asDiagonal().toDenseMatrix()};
 }
 
-void PoseGraph::changeWorldFrame(const lie::SE3& T_new_old) {
-  for (lie::SE3& pose : odometry_poses_) pose = T_new_old * pose;
-  for (lie::SE3& pose : poses_) pose = T_new_old * pose;
-  if (T_enu_world_) setEnuWorld(*T_enu_world_ * T_new_old.inverse());
-}
-
-void PoseGraph::setEnuWorld(const lie::SE3& T_enu_world) {
+void PoseGraph::setEnuMap(const lie::SE3& T_enu_map) {
   std::array<double, backend::kEnuWorldSize> block{};
-  backend::writeEnuWorldBlock(T_enu_world, block.data());
-  T_enu_world_ = backend::enuWorldFromBlock(block.data());
+  backend::writeEnuWorldBlock(T_enu_map, block.data());
+  T_enu_map_ = backend::enuWorldFromBlock(block.data());
   unsolved_ = unsolved_ || !gnss_.empty();
 }
 
 void PoseGraph::addGnss(const GnssObservation& observation) {
-  if (!T_enu_world_) throw std::logic_error("PoseGraph::addGnss before setEnuWorld");
+  if (!T_enu_map_) throw std::logic_error("PoseGraph::addGnss before setEnuMap");
   if (observation.keyframe >= size()) throw std::logic_error("PoseGraph::addGnss: no such keyframe");
   gnss_.push_back(observation);
   unsolved_ = true;
@@ -70,9 +64,9 @@ void PoseGraph::addGnss(const GnssObservation& observation) {
 
 std::vector<double> PoseGraph::gnssWhitenedResiduals() const {
   std::vector<double> norms;
-  if (!T_enu_world_) return norms;
+  if (!T_enu_map_) return norms;
   std::array<double, backend::kEnuWorldSize> enu{};
-  backend::writeEnuWorldBlock(*T_enu_world_, enu.data());
+  backend::writeEnuWorldBlock(*T_enu_map_, enu.data());
   for (const GnssObservation& g : gnss_) {
     PoseBlock pose{};
     backend::writePoseBlock(poses_[g.keyframe], pose.data());
@@ -95,9 +89,9 @@ double PoseGraph::addLoopIfConsistent(const RelativePose& loop, double max_chi2)
   return chi2;
 }
 
-void PoseGraph::addPosition(std::size_t keyframe, const Eigen::Vector3d& p_world,
+void PoseGraph::addPosition(std::size_t keyframe, const Eigen::Vector3d& p_map,
                             const Eigen::Matrix3d& covariance, double huber_sigmas) {
-  positions_.push_back({keyframe, p_world, covariance, huber_sigmas});
+  positions_.push_back({keyframe, p_map, covariance, huber_sigmas});
 }
 
 double PoseGraph::optimize() {
@@ -124,13 +118,13 @@ double PoseGraph::optimize() {
   for (const Position& position : positions_) {
     ceres::LossFunction* loss =
         position.huber_sigmas > 0.0 ? new ceres::HuberLoss(position.huber_sigmas) : nullptr;
-    problem.AddResidualBlock(new backend::PositionFactor(position.p_world, position.covariance),
+    problem.AddResidualBlock(new backend::PositionFactor(position.p_map, position.covariance),
                              loss, blocks[position.keyframe].data());
   }
   // The ENU block is free in yaw and translation; see the header for the gauge.
   std::array<double, backend::kEnuWorldSize> enu{};
   if (!gnss_.empty()) {
-    backend::writeEnuWorldBlock(*T_enu_world_, enu.data());
+    backend::writeEnuWorldBlock(*T_enu_map_, enu.data());
     problem.AddParameterBlock(enu.data(), backend::kEnuWorldSize);
     for (const GnssObservation& g : gnss_) {
       ceres::LossFunction* robust =
@@ -151,7 +145,7 @@ double PoseGraph::optimize() {
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   for (std::size_t k = 0; k < size(); ++k) poses_[k] = backend::poseFromBlock(blocks[k].data());
-  if (!gnss_.empty()) T_enu_world_ = backend::enuWorldFromBlock(enu.data());
+  if (!gnss_.empty()) T_enu_map_ = backend::enuWorldFromBlock(enu.data());
   unsolved_ = false;
   cost_ = summary.final_cost;
   return cost_;

@@ -8,9 +8,7 @@ namespace {
 
 /// T with its rotation reduced to the turn about z, keeping where it maps `p_anchor`.
 lie::SE3 turnAboutZ(const lie::SE3& T, const Eigen::Vector3d& p_anchor) {
-  const Eigen::Matrix3d R = T.rotation().matrix();
-  const double yaw_rad = std::atan2(R(1, 0), R(0, 0));
-  const lie::SO3 R_z = lie::SO3::fromRollPitchYaw(0.0, 0.0, yaw_rad);
+  const lie::SO3 R_z = lie::SO3::fromRollPitchYaw(0.0, 0.0, T.rotation().yaw());
   return lie::SE3(R_z, T * p_anchor - R_z * p_anchor);
 }
 
@@ -28,27 +26,19 @@ void OdometryCorrection::addKeyframe(double t_s, const lie::SE3& T_odom_keyframe
   while (local_map_.size() > local_map_keyframes_) local_map_.pop_front();
 }
 
-void OdometryCorrection::changeOdomFrame(const lie::SE3& T_new_old) {
-  if (!T_map_odom_.matrix().isIdentity())
-    throw std::logic_error("OdometryCorrection: the odom frame changed after a correction");
-  for (lie::SE3& T_odom_keyframe : T_odom_keyframes_) T_odom_keyframe = T_new_old * T_odom_keyframe;
-  for (LocalMapKeyframe& keyframe : local_map_)
-    keyframe.T_odom_keyframe = T_new_old * keyframe.T_odom_keyframe;
-}
-
 bool OdometryCorrection::apply(const mapping::GraphSnapshot& snapshot, bool keep_gravity,
-                               LidarInertialOdometry& odometry) {
+                               Odometry& odometry) {
   const std::size_t k = snapshot.keyframe;
-  const std::size_t count = snapshot.poses_T_world_body.size();
+  const std::size_t count = snapshot.poses_T_map_body.size();
   if (k >= T_odom_keyframes_.size() || count == 0 || count > k + 1)
     throw std::logic_error("OdometryCorrection: a snapshot of unknown keyframes");
-  const lie::SE3& T_graph_k = snapshot.poses_T_world_body.back();
+  const lie::SE3& T_map_k = snapshot.poses_T_map_body.back();
   const lie::SE3& T_odom_k = T_odom_keyframes_[k];
-  T_map_odom_ = T_graph_k * T_odom_k.inverse();
+  T_map_odom_ = T_map_k * T_odom_k.inverse();
   if (keep_gravity) T_map_odom_ = turnAboutZ(T_map_odom_, T_odom_k.translation());
 
   // The local map's keyframes up to k in the graph's shape, anchored at keyframe k.
-  const lie::SE3 T_odom_graph = T_odom_k * T_graph_k.inverse();
+  const lie::SE3 T_odom_map = T_odom_k * T_map_k.inverse();
   const std::size_t first_id = k + 1 - count;
   const std::size_t local_first_id = T_odom_keyframes_.size() - local_map_.size();
   bool bent = false;
@@ -56,7 +46,7 @@ bool OdometryCorrection::apply(const mapping::GraphSnapshot& snapshot, bool keep
   for (std::size_t i = 0; i < local_map_.size(); ++i) {
     const std::size_t id = local_first_id + i;
     reshaped.push_back(id >= first_id && id <= k
-                           ? T_odom_graph * snapshot.poses_T_world_body[id - first_id]
+                           ? T_odom_map * snapshot.poses_T_map_body[id - first_id]
                            : local_map_[i].T_odom_keyframe);
     bent = bent || movedApart(reshaped.back(), local_map_[i].T_odom_keyframe);
   }

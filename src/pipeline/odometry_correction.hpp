@@ -5,12 +5,12 @@
 // Frames as in ROS REP-105: the odometry runs in `odom`, continuous and gravity-aligned, the
 // frame the mapping graph receives its keyframes in; the graph's corrected poses are in `map`.
 // After the graph has handled keyframe k, its snapshot gives
-//   - T_map_odom = T_graph_k * T_odom_k^-1, with an IMU reduced to the turn about z and the
+//   - T_map_odom = T_map_k * T_odom_k^-1, with an IMU reduced to the turn about z and the
 //     translation that still put keyframe k's position where the graph has it (the published
 //     orientation keeps the IMU's roll and pitch). Live poses are published as
 //     T_map_odom * T_odom_body (trajectory_online.tum).
 //   - the local map's shape: keyframes up to k take the graph's relative poses, anchored at
-//     keyframe k's odometry pose (T_odom_i = T_odom_k * T_graph_k^-1 * T_graph_i), the later ones
+//     keyframe k's odometry pose (T_odom_i = T_odom_k * T_map_k^-1 * T_map_i), the later ones
 //     keep theirs. When that moves a local-map keyframe by more than kMinShiftM or kMinTurnRad,
 //     the local map is rebuilt from these poses. A rigid correction alone (the usual case: a
 //     loop moves the recent keyframes together) changes only T_map_odom and costs nothing.
@@ -27,7 +27,7 @@
 
 #include "taiga/lie/se3.hpp"
 #include "taiga/mapping/mapper.hpp"
-#include "taiga/pipeline/lidar_inertial_odometry.hpp"
+#include "taiga/pipeline/odometry.hpp"
 
 namespace taiga::pipeline {
 
@@ -47,12 +47,10 @@ class OdometryCorrection {
   const lie::SE3& T_map_odom() const { return T_map_odom_; }
   /// Keyframe ids 0, 1, ... in order, at their pose in the odom frame.
   void addKeyframe(double t_s, const lie::SE3& T_odom_keyframe);
-  /// The odometry levelled its frame (before any snapshot was applied): T_new_old.
-  void changeOdomFrame(const lie::SE3& T_new_old);
   /// Takes the graph's snapshot: updates T_map_odom and, when the graph bent the local map's
   /// keyframes, rebuilds the odometry's local map. Returns whether it did.
   bool apply(const mapping::GraphSnapshot& snapshot, bool keep_gravity,
-             LidarInertialOdometry& odometry);
+             Odometry& odometry);
 
  private:
   struct LocalMapKeyframe {

@@ -1,11 +1,14 @@
 #pragma once
-// Georeferencing at the end of taiga run (issue 9): with GNSS fixes in the recording, the
-// corrected trajectory is fitted to them with the config's georef method
-// (georef::georeference), and the trajectory and the map are written in the projected CRS under
+// Georeferencing in taiga run (issue 9). GnssRecorder observes the SLAM system: it keeps the
+// fixes (and the IMU's absolute orientation, which only the pf6 fit uses) and georeferences each
+// scan's pose as it is published with the fixes received so far (georef/online.hpp). At the end,
+// georeferenceRun fits the corrected trajectory to the fixes with the config's georef method
+// (georef::georeference) and writes the trajectory and the map in the projected CRS under
 // RUN/georef/. Fixes that cannot georeference the run (all gated, too few overlapping the
 // trajectory) leave every other output intact: the report says why. Internal to the pipeline.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,28 +19,47 @@
 #include "taiga/lie/se3.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/pipeline/run.hpp"
+#include "taiga/pipeline/slam_system.hpp"
 
 namespace taiga::pipeline {
 
 struct RunMap {
   const mapping::KeyframeStore& store;
-  const std::vector<lie::SE3>& poses_T_world_body;
+  const std::vector<lie::SE3>& poses_T_map_body;
   double voxel_m = 0.0;
 };
 
+/// `trajectory`: T_map_body, corrected by the mapping graph.
 GeorefRunReport georeferenceRun(const Trajectory& trajectory, const georef::GnssInput& gnss,
                                 const SystemConfig& config, const std::string& recording_name,
                                 const RunMap& map, const std::filesystem::path& out_dir);
 
-/// A scan's pose in the grid as the online georeferencer gave it when the scan was processed.
-struct OnlineGridPose {
-  georef::GridPose pose;
-  Eigen::Matrix<double, 6, 1> sigma;  ///< of the estimate then: east, north, up, roll, pitch, yaw
-  std::size_t fixes = 0;              ///< fixes the estimate used
-};
+class GnssRecorder final : public SlamObserver {
+ public:
+  explicit GnssRecorder(const SystemConfig& config);
 
-/// DIR/trajectory_online_epsgNNNN.csv: one row per scan from the first online estimate on.
-void writeOnlineGeoreference(const std::filesystem::path& dir,
-                             const std::vector<OnlineGridPose>& poses, int epsg);
+  void onImu(const ImuSample& sample) override;
+  void onGnssFix(const GnssFix& fix) override;
+  void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
+
+  const georef::GnssInput& input() const { return gnss_; }
+  /// DIR/trajectory_online_epsgNNNN.csv: one row per scan from the first online estimate on;
+  /// nothing when there was none.
+  void writeOnline(const std::filesystem::path& dir) const;
+
+ private:
+  /// A scan's pose in the grid as the online georeferencer gave it when the scan was published.
+  struct OnlineGridPose {
+    georef::GridPose pose;
+    Eigen::Matrix<double, 6, 1> sigma;  ///< of the estimate then: east, north, up, roll, pitch, yaw
+    std::size_t fixes = 0;              ///< fixes the estimate used
+  };
+
+  GeorefConfig config_;
+  bool keep_imu_orientation_;
+  georef::GnssInput gnss_{.from_recording = true};
+  std::optional<georef::OnlineGeoreferencer> online_;
+  std::vector<OnlineGridPose> online_poses_;
+};
 
 }  // namespace taiga::pipeline

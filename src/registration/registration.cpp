@@ -23,6 +23,18 @@ std::string methodName(Method method) {
   return "?";
 }
 
+RegistrationConfig registrationConfigFor(const OdometryConfig& odometry) {
+  RegistrationConfig config;
+  // OdometryConfig::validate() admits only the names methodFromName knows.
+  config.method = methodFromName(odometry.method).value_or(Method::kNdt);
+  const std::vector<double> resolutions_m = odometry.ndtResolutionsM();
+  config.ndt.resolution_m = resolutions_m.back();
+  config.ndt.coarse_resolutions_m.assign(resolutions_m.begin(), resolutions_m.end() - 1);
+  config.ndt.search =
+      odometry.ndt_neighbours == "direct1" ? NeighbourSearch::kDirect1 : NeighbourSearch::kDirect7;
+  return config;
+}
+
 RegistrationResult registerClouds(std::span<const Eigen::Vector3d> source,
                                   std::span<const Eigen::Vector3d> target, const lie::SE3& guess,
                                   const RegistrationConfig& config) {

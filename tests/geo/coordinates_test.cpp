@@ -45,8 +45,8 @@ TEST(CoordinateConverter, Tm35finOnTheCentralMeridianIsTheScaledMeridianArc) {
 }
 
 TEST(CoordinateConverter, HelsinkiInTm35fin) {
-  // Helsinki cathedral area, 60.1699 N 24.9384 E: E 385611.3 N 6672118.4 (DESIGN.md; the value the
-  // National Land Survey's converter gives for EUREF-FIN -> ETRS-TM35FIN).
+  // Helsinki cathedral area, 60.1699 N 24.9384 E: E 385611.3 N 6672118.4 (the value the National
+  // Land Survey's converter gives for EUREF-FIN -> ETRS-TM35FIN).
   const CoordinateConverter tm35fin(3067);
   const Eigen::Vector3d enh = tm35fin.toProjected({60.1699, 24.9384, 0.0});
   EXPECT_NEAR(enh.x(), 385611.3, 0.1);

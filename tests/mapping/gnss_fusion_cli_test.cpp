@@ -1,5 +1,5 @@
 // `taiga run` with mapping.gnss_fusion on, as users run it: the fixes reach the mapping graph,
-// summary.json reports the graph's T_enu_world, which with exact fixes puts the trajectory onto
+// summary.json reports the graph's T_enu_map, which with exact fixes puts the trajectory onto
 // the truth, and a second run gives the same bytes (the mapping thread's timing does not matter).
 #include <gtest/gtest.h>
 
@@ -62,13 +62,13 @@ TEST(GnssFusionCli, TaigaRunFusesTheFixesAndReportsTheMapToEnuTransform) {
   const auto& fusion = summary["gnss_fusion"];
   EXPECT_GE(fusion["used"].get<int>(), 20) << fusion.dump(2);
   EXPECT_EQ(fusion["gated"].get<int>(), 0);
-  ASSERT_TRUE(fusion.contains("T_enu_world")) << fusion.dump(2);
+  ASSERT_TRUE(fusion.contains("T_enu_map")) << fusion.dump(2);
 
-  // The graph's T_enu_world, with exact fixes, takes the run's trajectory onto the truth in the
+  // The graph's T_enu_map, with exact fixes, takes the run's trajectory onto the truth in the
   // ENU frame at the fusion's origin, to within the odometry's error.
-  Eigen::Matrix4d T_enu_world;
+  Eigen::Matrix4d T_enu_map;
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) T_enu_world(i, j) = fusion["T_enu_world"][i][j].get<double>();
+    for (int j = 0; j < 4; ++j) T_enu_map(i, j) = fusion["T_enu_map"][i][j].get<double>();
   const geo::Geodetic fusion_origin{fusion["enu_origin"]["latitude_deg"].get<double>(),
                                     fusion["enu_origin"]["longitude_deg"].get<double>(),
                                     fusion["enu_origin"]["height_ellipsoid_m"].get<double>()};
@@ -89,7 +89,7 @@ TEST(GnssFusionCli, TaigaRunFusesTheFixesAndReportsTheMapToEnuTransform) {
         fusion_origin,
         converter.fromEnu(sim_origin, R_enu_simworld * T_simworld_body->translation()));
     const Eigen::Vector3d p_fused =
-        (T_enu_world * pose.pose.translation().homogeneous()).head<3>();
+        (T_enu_map * pose.pose.translation().homogeneous()).head<3>();
     worst_horizontal_m = std::max(worst_horizontal_m, (p_fused - p_truth).head<2>().norm());
     sum_squared_m2 += (p_fused - p_truth).squaredNorm();
     ++compared;

@@ -73,11 +73,11 @@ TEST(MapExport, EveryPointLandsInTheWorldWithItsTimeIntensityRingAndKeyframe) {
   const io::LoadedPoints ply = io::readCloudFile(f.dir.file("map.ply"));
   EXPECT_EQ(std::size_t{ply.packed.width} * ply.packed.height, 200u);
 
-  // A corrected pose moves that keyframe's points, and T_out_world moves all of them.
+  // A corrected pose moves that keyframe's points, and T_out_map moves all of them.
   std::vector<lie::SE3> corrected = f.poses;
   corrected[2] = lie::SE3(lie::SO3(), Eigen::Vector3d(0, 0, 1)) * corrected[2];
   exportMap(f.store, corrected, las,
-            {.T_out_world = Eigen::Affine3d(Eigen::Translation3d(385000.0, 6672000.0, 0.0))});
+            {.T_out_map = Eigen::Affine3d(Eigen::Translation3d(385000.0, 6672000.0, 0.0))});
   const PointCloud moved = io::LasReader(las).readStrided(1);
   EXPECT_NEAR(moved.positions[0].x() - map.positions[0].x(), 385000.0, 0.001);
   EXPECT_NEAR(moved.positions[100].z() - map.positions[100].z(), 1.0, 0.001);

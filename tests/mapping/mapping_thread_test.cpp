@@ -22,7 +22,9 @@ TEST(MappingThread, PublishesItsPosesSoARunningRunCanBeExported) {
   const test::TempDir dir;
   KeyframeStore store = KeyframeStore::create(dir.path());
   MappingThread thread(MappingConfig{}, OdometryConfig{}, store,
-                       {.write_live_poses = true, .snapshot_keyframes = 2});
+                       {.snapshot_keyframes = 2, .after_keyframe = [&store](const Mapper& mapper) {
+                          store.writePoses(mapper.keyframeTrajectory());
+                        }});
   for (std::size_t k = 0; k < 3; ++k) {
     const double t_s = 1.0 + static_cast<double>(k);
     const std::uint64_t id = store.add(t_s, poseAt(2.0 * k), lineOfPoints());
@@ -34,9 +36,9 @@ TEST(MappingThread, PublishesItsPosesSoARunningRunCanBeExported) {
   const std::optional<GraphSnapshot> snapshot = thread.waitForSnapshot(2);
   ASSERT_TRUE(snapshot.has_value());
   EXPECT_EQ(snapshot->keyframe, 2u);
-  ASSERT_EQ(snapshot->poses_T_world_body.size(), 2u);  // keyframes 1 and 2
-  EXPECT_NEAR(snapshot->poses_T_world_body[0].translation().x(), 2.0, 1e-12);
-  EXPECT_NEAR(snapshot->poses_T_world_body[1].translation().x(), 4.0, 1e-12);
+  ASSERT_EQ(snapshot->poses_T_map_body.size(), 2u);  // keyframes 1 and 2
+  EXPECT_NEAR(snapshot->poses_T_map_body[0].translation().x(), 2.0, 1e-12);
+  EXPECT_NEAR(snapshot->poses_T_map_body[1].translation().x(), 4.0, 1e-12);
 
   // While the thread still runs: the store on disk lists the keyframes the graph holds, and the
   // map exports from it.
@@ -56,8 +58,8 @@ TEST(MappingThread, SnapshotsAreTakenInOrderAndOlderOnesDropped) {
   for (std::size_t k = 0; k < 5; ++k) thread.addKeyframe(k, 1.0 + k, poseAt(1.0 * k));
   const std::optional<GraphSnapshot> third = thread.waitForSnapshot(3);
   ASSERT_TRUE(third.has_value());
-  ASSERT_EQ(third->poses_T_world_body.size(), 3u);  // keyframes 1, 2, 3
-  EXPECT_NEAR(third->poses_T_world_body.front().translation().x(), 1.0, 1e-12);
+  ASSERT_EQ(third->poses_T_map_body.size(), 3u);  // keyframes 1, 2, 3
+  EXPECT_NEAR(third->poses_T_map_body.front().translation().x(), 1.0, 1e-12);
   EXPECT_FALSE(thread.waitForSnapshot(1).has_value());  // dropped when 3 was taken
   EXPECT_EQ(thread.waitForSnapshot(4)->keyframe, 4u);
   thread.finish();

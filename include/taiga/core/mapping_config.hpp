@@ -43,7 +43,7 @@ struct MappingConfig final : ConfigSection {
   /// so slowly wandering errors do not count as independent. 0: white noise.
   double gnss_correlation_time_s = 30.0;
   /// GNSS factors enter the graph only once this many fixes spread over this distance (the
-  /// yaw of T_enu_world must be observable); T_enu_world starts from the robust post-fit.
+  /// yaw of T_enu_map must be observable); T_enu_map starts from the robust post-fit.
   int gnss_min_fixes = 5;
   double gnss_min_spread_m = 10.0;
   /// The graph is re-solved with new fixes at most once per this much recording time.

@@ -6,14 +6,13 @@
 #include <vector>
 
 #include "taiga/core/config.hpp"
+#include "taiga/core/imu_noise.hpp"
 
 namespace taiga {
 
-struct ImuNoiseConfig final : ConfigSection {
-  double accel_noise_density = 2.0e-3;     ///< m/s^2/sqrt(Hz)
-  double gyro_noise_density = 1.7e-4;      ///< rad/s/sqrt(Hz)
-  double accel_bias_random_walk = 3.0e-4;  ///< m/s^3/sqrt(Hz)
-  double gyro_bias_random_walk = 2.0e-5;   ///< rad/s^2/sqrt(Hz)
+/// The `odometry.imu` section: the noise model (used as it is by the preintegration) and the
+/// local gravity magnitude.
+struct ImuNoiseConfig final : ConfigSection, ImuNoise {
   double gravity_mps2 = 9.81;
 
   void visit(ConfigVisitor& v) override;

@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 
+#include "taiga/core/imu_noise.hpp"
 #include "taiga/lie/so3.hpp"
 
 namespace taiga::imu {
@@ -36,12 +37,7 @@ struct ImuBias {
 };
 
 /// Continuous-time noise densities, as IMU datasheets and Kalibr give them.
-struct ImuNoise {
-  double accel_noise_density = 2.0e-3;     ///< m/s^2/sqrt(Hz)
-  double gyro_noise_density = 1.7e-4;      ///< rad/s/sqrt(Hz)
-  double accel_bias_random_walk = 3.0e-4;  ///< m/s^3/sqrt(Hz)
-  double gyro_bias_random_walk = 2.0e-5;   ///< rad/s^2/sqrt(Hz)
-};
+using taiga::ImuNoise;  // core/imu_noise.hpp
 
 /// Pose and velocity of the body in the world frame (z up, gravity along -z).
 struct NavState {

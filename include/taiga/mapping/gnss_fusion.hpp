@@ -13,7 +13,7 @@
 //    time assumes steady motion between keyframes. Fixes before the first keyframe or after the
 //    last are not used.
 // 3. Start: once gnss_min_fixes fixes are attached and the track spans gnss_min_spread_m
-//    horizontally, T_enu_world starts from georef::fitRobust on them and every attached fix
+//    horizontally, T_enu_map starts from georef::fitRobust on them and every attached fix
 //    becomes a factor; later fixes become factors as they are attached.
 // 4. Weights: each fix is whitened by its reported covariance under a Huber kernel at
 //    gnss_huber_sigmas, and its cost divided by the correlation factor
@@ -45,7 +45,7 @@ struct GnssFusionReport {
   /// The ENU frame's origin (the first fix that passed the gate) and the estimated transform
   /// from the map into it (yaw and translation; none when fusion never started).
   std::optional<geo::Geodetic> enu_origin;
-  std::optional<lie::SE3> T_enu_world;
+  std::optional<lie::SE3> T_enu_map;
 };
 
 class GnssFusion {

@@ -8,8 +8,8 @@
 // registration_cache_keyframes most recently used copies stay in RAM (least recently used
 // evicted), and a copy not cached is rebuilt from the keyframe file with the same deterministic
 // filter, so it is bit for bit the copy add() made. load() reads the full scan back. The poses
-// are kept in RAM; setPoses() replaces them when the world frame is levelled or the mapping
-// graph corrects them, and writePoses() saves them as DIR/poses.tum (TUM, T_world_body, one line
+// are kept in RAM; setPoses() replaces them when the mapping
+// graph corrects them, and writePoses() saves them as DIR/poses.tum (TUM, T_map_body, one line
 // per keyframe in id order), so that `taiga export-map DIR` re-exports a finished run with its
 // final poses, or a running one with its current poses.
 //
@@ -53,7 +53,8 @@ struct RegistrationCacheStatistics {
 struct KeyframeInfo {
   std::uint64_t id = 0;
   double t_s = 0.0;
-  lie::SE3 T_world_body;
+  /// The odometry's T_odom_body from add() until setPoses() gives the graph's T_map_body.
+  lie::SE3 T_map_body;
   std::uint64_t point_count = 0;
 };
 
@@ -70,9 +71,10 @@ class KeyframeStore {
   KeyframeStore& operator=(KeyframeStore&&) noexcept;
   ~KeyframeStore();
 
-  /// Stores a keyframe (its time, pose and full scan in the body frame) and returns its id.
+  /// Stores a keyframe (its time, odometry pose and full scan in the body frame) and returns its
+  /// id.
   /// t_s must be later than the previous keyframe's. InputError when the file cannot be written.
-  std::uint64_t add(double t_s, const lie::SE3& T_world_body, const PointCloud& cloud_in_body);
+  std::uint64_t add(double t_s, const lie::SE3& T_odom_body, const PointCloud& cloud_in_body);
 
   std::size_t size() const;
   bool empty() const { return size() == 0; }
@@ -90,19 +92,19 @@ class KeyframeStore {
 
   KeyframeInfo info(std::uint64_t id) const;
   lie::SE3 pose(std::uint64_t id) const;
-  /// Every keyframe's T_world_body, in id order.
+  /// Every keyframe's T_map_body, in id order.
   std::vector<lie::SE3> poses() const;
   /// The poses as a trajectory (keyframe times).
   Trajectory trajectory() const;
   /// Replaces every pose (one per keyframe, in id order) in RAM; writePoses() saves them.
-  void setPoses(const std::vector<lie::SE3>& poses_T_world_body);
+  void setPoses(const std::vector<lie::SE3>& poses_T_map_body);
   /// Rewrites DIR/poses.tum from the poses in RAM (write to a temporary file, then rename).
   void writePoses() const;
-  /// Rewrites DIR/poses.tum with these poses of keyframes 0, 1, ... (their times and T_world_body;
+  /// Rewrites DIR/poses.tum with these poses of keyframes 0, 1, ... (their times and T_map_body;
   /// may be fewer than the store holds), the same way. A running `taiga run` publishes its
   /// mapping graph's current poses so, and open() then sees a consistent snapshot of the run:
   /// every keyframe it lists has its file complete.
-  void writePoses(const Trajectory& poses_T_world_body) const;
+  void writePoses(const Trajectory& poses_T_map_body) const;
 
  private:
   struct Impl;

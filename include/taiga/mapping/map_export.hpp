@@ -27,10 +27,10 @@ namespace taiga::mapping {
 struct MapExportOptions {
   double voxel_m = 0.0;  ///< > 0: one point per voxel of this edge, m (`--map-voxel`)
   bool write_ply = false;  ///< also the same points as binary PLY (las path with .ply)
-  /// Output frame: p_out = T_out_world * T_world_body * p_body; affine, so that it can carry a
+  /// Output frame: p_out = T_out_map * T_map_body * p_body; affine, so that it can carry a
   /// projected grid's scale factor (e.g. a georeferencing's T_epsg_world; identity: the map in
-  /// the odometry's world frame).
-  Eigen::Affine3d T_out_world = Eigen::Affine3d::Identity();
+  /// the map frame).
+  Eigen::Affine3d T_out_map = Eigen::Affine3d::Identity();
   std::string wkt;  ///< OGC WKT of the output frame for the LAS header; empty: local coordinates
 };
 
@@ -40,10 +40,10 @@ struct MapExportSummary {
   std::uint64_t points_written = 0;  ///< after decimation
 };
 
-/// Writes the map of `store` with `poses_T_world_body` (one per keyframe, in id order) to
+/// Writes the map of `store` with `poses_T_map_body` (one per keyframe, in id order) to
 /// `las_path`. InputError when a keyframe file is unreadable or the output cannot be written.
 MapExportSummary exportMap(const KeyframeStore& store,
-                           const std::vector<lie::SE3>& poses_T_world_body,
+                           const std::vector<lie::SE3>& poses_T_map_body,
                            const std::filesystem::path& las_path,
                            const MapExportOptions& options = {});
 

@@ -47,17 +47,16 @@ class Mapper {
   Mapper(const MappingConfig& config, const OdometryConfig& odometry, const KeyframeStore& store,
          LoopVerifier verify_loop = verifyLoop);
 
-  /// Keyframe `id` of the store (ids in order, from 0) at its odometry pose.
+  /// Keyframe `id` of the store (ids in order, from 0) at its odometry pose. The graph's map
+  /// frame starts as the odom frame at the first keyframe.
   void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
-  /// The odometry re-expressed its world frame (gravity levelling): T_new_old.
-  void changeWorldFrame(const lie::SE3& T_new_old) { graph_.changeWorldFrame(T_new_old); }
   /// A GNSS fix (recording clock); used when MappingConfig::gnss_fusion is on, ignored
   /// otherwise. It waits for the first keyframe at or after its time (gnss_fusion.hpp).
   void addGnssFix(const GnssFix& fix);
   /// End of the input: solves the graph once more when GNSS factors arrived since its last
   /// solve. Call once, after the last keyframe and fix.
   void finish();
-  /// What became of the GNSS fixes and the estimated T_enu_world (none with fusion off).
+  /// What became of the GNSS fixes and the estimated T_enu_map (none with fusion off).
   std::optional<GnssFusionReport> gnssReport() const;
 
   const PoseGraph& graph() const { return graph_; }
@@ -84,16 +83,16 @@ class Mapper {
 /// the odometry rebuilds its local map from (MappingConfig::correct_odometry).
 struct GraphSnapshot {
   std::size_t keyframe = 0;                  ///< the keyframe just handled, the last of the poses
-  std::vector<lie::SE3> poses_T_world_body;  ///< keyframes keyframe - size + 1 ... keyframe
+  std::vector<lie::SE3> poses_T_map_body;  ///< keyframes keyframe - size + 1 ... keyframe
 };
 
 struct MappingThreadOptions {
-  /// Rewrite the store's poses.tum with the graph's poses after every keyframe, so that
-  /// `taiga export-map` can export the map of a run still going.
-  bool write_live_poses = false;
   /// > 0: after every keyframe, keep a GraphSnapshot of this many keyframes for
   /// waitForSnapshot().
   std::size_t snapshot_keyframes = 0;
+  /// Called on the mapping thread after every keyframe, with the graph as it is then (e.g. to
+  /// rewrite the store's poses.tum, so that `taiga export-map` can export a running run's map).
+  std::function<void(const Mapper&)> after_keyframe;
 };
 
 /// A Mapper on its own thread. Messages are handled in order, so the result does not depend on
@@ -107,7 +106,6 @@ class MappingThread {
   MappingThread& operator=(const MappingThread&) = delete;
 
   void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
-  void changeWorldFrame(const lie::SE3& T_new_old);
   /// Fixes are handled in the order of the calls, interleaved with the keyframes, so the
   /// result depends on that order only, not on the thread's timing.
   void addGnssFix(const GnssFix& fix);
@@ -126,14 +124,13 @@ class MappingThread {
     double t_s;
     lie::SE3 T_odom_body;
   };
-  using Message = std::variant<KeyframeMessage, lie::SE3, GnssFix>;
+  using Message = std::variant<KeyframeMessage, GnssFix>;
   void push(Message message);
   void work();
-  /// After keyframe `id`: the live poses and the snapshot, as options_ asks.
+  /// After keyframe `id`: options_.after_keyframe and the snapshot.
   void publish(std::size_t id);
 
   Mapper mapper_;
-  const KeyframeStore& store_;
   MappingThreadOptions options_;
   std::mutex mutex_;
   std::condition_variable wake_;

@@ -1,15 +1,15 @@
 #pragma once
-// The mapping graph of thesis 3.1.2: one node per keyframe (T_world_body), consecutive keyframes
+// The mapping graph of thesis 3.1.2: one node per keyframe (T_map_body), consecutive keyframes
 // joined by the odometry's relative pose, loop closures as further relative poses, and absolute
 // position factors (GNSS, issue 9) through addPosition(). Solved with Ceres when a loop or an
 // absolute factor arrives; in between, a new keyframe is placed by chaining the odometry onto
 // the corrected pose of the previous one.
 //
-// Gauge: without absolute position factors the first keyframe is held fixed, so the corrected
-// map stays in the odometry's world frame at its start. GNSS factors (addGnss, backend/
-// gnss_factor.hpp) relate the map to ENU through the estimated T_enu_world (yaw and translation),
-// so they do not fix the world frame: with them the first keyframe stays fixed too, otherwise the
-// world frame and T_enu_world could slide together (a 4-DoF null space) and noisy GNSS heights
+// Gauge: without absolute position factors the first keyframe is held fixed, so the map frame
+// is the odom frame at the first keyframe (docs/frames.md). GNSS factors (addGnss, backend/
+// gnss_factor.hpp) relate the map to ENU through the estimated T_enu_map (yaw and translation),
+// so they do not fix the map frame: with them the first keyframe stays fixed too, otherwise the
+// map frame and T_enu_map could slide together (a 4-DoF null space) and noisy GNSS heights
 // could tilt the whole map away from gravity.
 
 #include <Eigen/Core>
@@ -59,27 +59,22 @@ class PoseGraph {
   /// Mahalanobis distance against the odometry's accumulated uncertainty; a false one bends the
   /// graph and costs far more. Returns that chi^2; the graph is unchanged when it is above.
   double addLoopIfConsistent(const RelativePose& loop, double max_chi2);
-  /// An absolute position of a keyframe in the world frame (m) with its covariance (m^2);
+  /// An absolute position of a keyframe in the map frame (m) with its covariance (m^2);
   /// `huber_sigmas` > 0 makes the factor robust beyond that many sigmas.
-  void addPosition(std::size_t keyframe, const Eigen::Vector3d& p_world,
+  void addPosition(std::size_t keyframe, const Eigen::Vector3d& p_map,
                    const Eigen::Matrix3d& covariance, double huber_sigmas = 0.0);
 
-  /// Starts (or resets) the estimate of T_enu_world; its roll and pitch are dropped. Needed
+  /// Starts (or resets) the estimate of T_enu_map; its roll and pitch are dropped. Needed
   /// before addGnss().
-  void setEnuWorld(const lie::SE3& T_enu_world);
-  /// The current T_enu_world (yaw and translation), once set.
-  const std::optional<lie::SE3>& enuWorld() const { return T_enu_world_; }
-  /// A GNSS factor; the graph must have T_enu_world (setEnuWorld) and the keyframe.
+  void setEnuMap(const lie::SE3& T_enu_map);
+  /// The current T_enu_map (yaw and translation), once set.
+  const std::optional<lie::SE3>& enuMap() const { return T_enu_map_; }
+  /// A GNSS factor; the graph must have T_enu_map (setEnuMap) and the keyframe.
   void addGnss(const GnssObservation& observation);
   const std::vector<GnssObservation>& gnss() const { return gnss_; }
-  /// Whitened residual norm of each GNSS factor at the current poses and T_enu_world (in
+  /// Whitened residual norm of each GNSS factor at the current poses and T_enu_map (in
   /// sigmas of the fix's covariance; the Huber kernel down-weights those above huber_sigmas).
   std::vector<double> gnssWhitenedResiduals() const;
-
-  /// Re-expresses every pose in a new world frame (T_new_old * pose); the factors are relative
-  /// and stay as they are, and T_enu_world becomes T_enu_world * T_new_old^-1 (its tilt
-  /// dropped). Only without absolute position factors.
-  void changeWorldFrame(const lie::SE3& T_new_old);
 
   /// Solves for every keyframe pose; returns the final cost.
   double optimize();
@@ -102,7 +97,7 @@ class PoseGraph {
  private:
   struct Position {
     std::size_t keyframe;
-    Eigen::Vector3d p_world;
+    Eigen::Vector3d p_map;
     Eigen::Matrix3d covariance;
     double huber_sigmas;
   };
@@ -115,7 +110,7 @@ class PoseGraph {
   std::vector<RelativePose> loops_;
   std::vector<Position> positions_;
   std::vector<GnssObservation> gnss_;
-  std::optional<lie::SE3> T_enu_world_;
+  std::optional<lie::SE3> T_enu_map_;
   bool unsolved_ = false;
   double cost_ = 0.0;
 };

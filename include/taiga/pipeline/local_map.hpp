@@ -1,6 +1,6 @@
 #pragma once
 // The local map that scans are registered to: the points of the latest keyframes, each in its
-// body frame with its pose in the world frame, so that corrected poses can move them (repose()).
+// body frame with its pose in the odom frame, so that corrected poses can move them (repose()).
 // Its NDT cells come from incremental voxel statistics, so adding a keyframe and dropping the
 // oldest costs only their own points (registration/voxel_statistics.hpp).
 //
@@ -43,13 +43,13 @@ class LocalMap {
 
   /// Adds one keyframe (its time, pose and points in its body frame), drops the oldest keyframe
   /// beyond max_keyframes, and starts building the search structures in the background.
-  void addKeyframe(double t_s, const lie::SE3& T_world_keyframe,
+  void addKeyframe(double t_s, const lie::SE3& T_odom_keyframe,
                    std::vector<Eigen::Vector3d> points_in_keyframe);
-  /// Moves every keyframe to a new pose (`T_world_keyframe_at(t_s, old T_world_keyframe)`), e.g.
+  /// Moves every keyframe to a new pose (`T_odom_keyframe_at(t_s, old T_odom_keyframe)`), e.g.
   /// the mapping graph's after a loop closure, and rebuilds the search structures from them. The
-  /// next registration waits for them: the old ones are in the old world frame.
-  void repose(const std::function<lie::SE3(double t_s, const lie::SE3& T_world_keyframe)>&
-                  T_world_keyframe_at);
+  /// next registration waits for them: the old ones hold the old poses.
+  void repose(const std::function<lie::SE3(double t_s, const lie::SE3& T_odom_keyframe)>&
+                  T_odom_keyframe_at);
   /// Drops every keyframe.
   void clear();
   /// Replaces the NDT passes (coarse to fine, at least one); only while the map is empty.
@@ -82,11 +82,11 @@ class LocalMap {
   registration::GicpConfig gicp_config_;
   struct Keyframe {
     double t_s = 0.0;
-    lie::SE3 T_world_keyframe;
+    lie::SE3 T_odom_keyframe;
     std::vector<Eigen::Vector3d> points_in_keyframe;
   };
   enum class Change { kAdd, kRemove };
-  /// Adds a keyframe's points, in the world frame, to the statistics, or removes them.
+  /// Adds a keyframe's points, in the odom frame, to the statistics, or removes them.
   void account(const Keyframe& keyframe, Change change);
 
   std::deque<Keyframe> keyframes_;

@@ -1,18 +1,19 @@
 #pragma once
-// `taiga run`: the odometry over a whole recording, with the outputs of DESIGN.md section 4:
-//   trajectory.tum       one pose per scan (T_world_body at the scan's end), corrected by the
-//                        mapping graph (loop closures)
+// `taiga run`: the SLAM system (slam_system.hpp) over a whole recording, and its outputs (frames
+// in docs/frames.md):
+//   trajectory.tum       one pose per scan (T_map_body at the scan's end): the odometry
+//                        corrected by the mapping graph (loop closures)
 //   trajectory_imu.tum   IMU-rate poses (propagated between scans), corrected likewise
-//   trajectory_odometry.tum  the odometry's per-scan poses in its continuous frame, uncorrected
-//   trajectory_online.tum    the per-scan poses as published live: with mapping.correct_odometry
-//                        in the mapping graph's frame, its corrections taken as they come
+//   trajectory_odometry.tum  the odometry's per-scan poses T_odom_body, uncorrected
+//   trajectory_online.tum    the per-scan poses as published live, T_map_odom * T_odom_body:
+//                        with mapping.correct_odometry the graph's corrections as they come
 //   keyframes.tum        the keyframe poses optimized by the mapping graph
 //   loops.csv            every loop closure attempt: candidate, fitness, correction, verdict
 //   keyframes/           every keyframe's full deskewed scan in the body frame (NNNNNN.tkf,
 //                        mapping/keyframe_file.hpp), written as keyframes are made so memory
 //                        stays flat, and their final poses (poses.tum): `taiga export-map`
 //                        re-exports the map from it
-//   map.las              every keyframe's scan in the world frame with its final pose (GPS
+//   map.las              every keyframe's scan in the map frame with its final pose (GPS
 //                        time = point time, point source ID = keyframe number), exported from
 //                        keyframes/ at the end of the run (mapping/map_export.hpp); map.ply on
 //                        request

@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 
+#include "taiga/core/odometry_config.hpp"
 #include "taiga/registration/gicp.hpp"
 #include "taiga/registration/ndt.hpp"
 #include "taiga/registration/result.hpp"
@@ -26,6 +27,12 @@ struct RegistrationConfig {
   GicpConfig gicp;
   bool compute_fitness = true;  ///< builds a kd-tree over the target for the fitness score
 };
+
+/// The registration of the odometry's configuration (odometry.method, the NDT passes of
+/// OdometryConfig::ndtResolutionsM() coarse to fine, odometry.ndt_neighbours): built here once and
+/// shared by the odometry, its initialization and loop closure, which adapt it where their
+/// problem differs.
+RegistrationConfig registrationConfigFor(const OdometryConfig& odometry);
 
 RegistrationResult registerClouds(std::span<const Eigen::Vector3d> source,
                                   std::span<const Eigen::Vector3d> target,

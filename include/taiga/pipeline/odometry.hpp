@@ -1,0 +1,126 @@
+#pragma once
+// The lidar-inertial odometry of thesis 3.1.1 and paper section 2 ("Robotics Approach in Mobile
+// Laser Scanning"; "Real-time lidar-inertial positioning and mapping for forestry automation"),
+// one scan at a time, in the continuous `odom` frame (docs/frames.md). The steps of addScan():
+//   1. predict the body's motion since the previous state (motion prior: IMU preintegration,
+//      or constant velocity without an IMU)
+//   2. deskew: the scan moved into the body frame at its end time with the poses predicted over
+//      its sweep (thesis Eq. 34-35); returns outside the range limits or in the rig's boxes
+//      dropped
+//   3. voxel filter -> registration source
+//   4. register the source to the local map from the prediction (NDT, D2D-NDT or GICP)
+//   5. judge the registration: rejected, inflated (degenerate) or used with the fitness-scaled
+//      covariance (thesis Eq. 36)
+//   6. fuse: the motion prior's state with the lidar factor (IMU: fixed-lag smoothing of the
+//      IMU and lidar factors -> pose, velocity, biases)
+//   7. keyframe test (thesis Eq. 37): the deskewed scan joins the local map
+//
+// With an IMU the odom frame is levelled once, gravity_alignment_s into the run (motion_prior.hpp):
+// the scan that levels it carries T_odom_unlevelled, and the earlier outcomes are in the
+// unlevelled start frame. SlamSystem holds them until then, so nothing past it sees that frame.
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "taiga/core/box.hpp"
+#include "taiga/core/odometry_config.hpp"
+#include "taiga/core/rig_config.hpp"
+#include "taiga/core/sensor_samples.hpp"
+#include "taiga/core/trajectory.hpp"
+#include "taiga/imu/preintegration.hpp"
+#include "taiga/io/recording.hpp"
+#include "taiga/pipeline/local_map.hpp"
+#include "taiga/registration/registration.hpp"
+
+namespace taiga::pipeline {
+
+class MotionPrior;
+class ScanPreparation;
+struct FirstScan;
+
+/// What happened to the lidar factor of a scan.
+enum class LidarFactor { kFirstScan, kUsed, kInflated, kRejected };
+const char* lidarFactorName(LidarFactor factor);
+
+/// Milliseconds per stage of one scan (timing.csv).
+struct ScanTiming {
+  double deskew_ms = 0.0;  ///< prediction and deskew
+  double filter_ms = 0.0;
+  double registration_ms = 0.0;
+  double optimization_ms = 0.0;  ///< judging the registration and fusing it
+  double map_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+struct ScanOutcome {
+  std::uint64_t scan_index = 0;
+  double t_s = 0.0;  ///< the state's time: the scan's end
+  lie::SE3 T_odom_body;
+  Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();
+  imu::ImuBias bias;
+  LidarFactor lidar = LidarFactor::kFirstScan;
+  std::string lidar_note;  ///< why a factor was rejected or inflated
+  registration::RegistrationResult registration;
+  std::size_t source_points = 0;
+  bool keyframe = false;
+  /// The full deskewed scan in the body frame at t_s, when this scan became a keyframe.
+  std::optional<PointCloud> keyframe_cloud_in_body;
+  /// IMU-rate poses T_odom_body after the previous state up to t_s (propagated, as published in
+  /// real time).
+  std::vector<StampedPose> imu_rate_poses;
+  /// Set once, on the scan that levelled the odom frame: the earlier outcomes' poses are in the
+  /// unlevelled start frame, and T_odom_unlevelled * pose re-expresses them.
+  std::optional<lie::SE3> T_odom_unlevelled;
+  ScanTiming timing;
+};
+
+class Odometry {
+ public:
+  /// `lidar_only`: constant-velocity prediction and deskew, no IMU (MotionPrior).
+  Odometry(const OdometryConfig& config, const RigConfig& rig, bool lidar_only);
+  ~Odometry();
+  Odometry(const Odometry&) = delete;
+  Odometry& operator=(const Odometry&) = delete;
+
+  /// IMU readings, in time order, in the IMU frame (rotated into the body frame here).
+  void addImu(const ImuSample& sample);
+  /// One scan: the outcomes it completes, oldest first. None while the IMU has not yet covered
+  /// the initialization window; the first scan's and the second's together once it has.
+  std::vector<ScanOutcome> addScan(const io::Scan& scan);
+
+  /// Boxes around moving parts of the rig (a harvester's boom), per scan, in the body frame:
+  /// returns inside the boxes of a scan's time span are dropped.
+  void setMovingBoxes(MovingBoxes boxes_body);
+  bool lidarOnly() const { return lidar_only_; }
+  /// True once the odom frame is final: levelled, or with no levelling to wait for (alignment
+  /// off, lidar-only).
+  bool odomFrameFinal() const;
+  /// Moves the local map's keyframes to `T_odom_keyframe_at(t_s, T_odom_keyframe)` and
+  /// rebuilds it, e.g. in the shape the mapping graph gave them after a loop closure
+  /// (MappingConfig::correct_odometry). The state stays. Between scans.
+  void reposeLocalMap(const std::function<lie::SE3(double t_s, const lie::SE3& T_odom_keyframe)>&
+                          T_odom_keyframe_at) {
+    local_map_.repose(T_odom_keyframe_at);
+  }
+  const std::string& initializationNote() const;
+
+ private:
+  std::optional<ScanOutcome> processScan(const io::Scan& scan);
+  ScanOutcome firstScanOutcome(FirstScan&& first);
+  registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
+                                                 const lie::SE3& guess_T_odom_body);
+  void maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body);
+
+  OdometryConfig config_;
+  bool lidar_only_;
+  registration::RegistrationConfig registration_;
+  std::unique_ptr<ScanPreparation> preparation_;
+  std::unique_ptr<MotionPrior> motion_;
+  LocalMap local_map_;
+  std::optional<lie::SE3> last_keyframe_T_odom_body_;
+};
+
+}  // namespace taiga::pipeline

@@ -1,0 +1,36 @@
+// The constant-velocity motion model of lidar-only odometry (motion_prior.hpp).
+#include "constant_velocity_prior.hpp"
+
+namespace taiga::pipeline {
+
+MotionPrediction ConstantVelocityPrior::predict(const io::Scan& scan) {
+  const Twist last = last_.value_or(Twist{scan.t_end_s});
+  auto predictedAt = [&](double t_s) {
+    return last.T_odom_body * lie::SE3::Exp(last.twist_per_s * (t_s - last.t_s));
+  };
+  MotionPrediction prediction;
+  prediction.T_odom_body = predictedAt(scan.t_end_s);
+  // Poses over the sweep every 10 ms (and at its end) for the deskew's interpolation.
+  constexpr double kStep_s = 0.01;
+  for (double t = scan.t_start_s; t < scan.t_end_s; t += kStep_s)
+    prediction.sweep_T_odom_body.append(t, predictedAt(t));
+  prediction.sweep_T_odom_body.append(scan.t_end_s, prediction.T_odom_body);
+  predicted_ = Twist{scan.t_end_s, prediction.T_odom_body};
+  return prediction;
+}
+
+MotionUpdate ConstantVelocityPrior::update(const std::optional<backend::PoseMeasurement>& lidar) {
+  // The registered pose where it was used, the prediction otherwise.
+  const Twist last = last_.value_or(Twist{predicted_.t_s});
+  const lie::SE3 T_odom_body = lidar ? lidar->T_world_body : predicted_.T_odom_body;
+  const double dt = predicted_.t_s - last.t_s;
+  last_ = Twist{predicted_.t_s, T_odom_body,
+                dt > 0.0 ? lie::Vector6((last.T_odom_body.inverse() * T_odom_body).Log() / dt)
+                         : lie::Vector6::Zero()};
+  MotionUpdate update;
+  update.state.T_odom_body = T_odom_body;
+  update.state.v_odom = T_odom_body.rotation() * last_->twist_per_s.head<3>();
+  return update;
+}
+
+}  // namespace taiga::pipeline

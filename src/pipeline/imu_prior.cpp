@@ -1,0 +1,113 @@
+#include "imu_prior.hpp"
+
+#include <algorithm>
+
+#include "constant_velocity_prior.hpp"
+#include "taiga/core/log.hpp"
+#include "taiga/imu/propagation.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+/// IMU readings needed before the first scan is used, s.
+constexpr double kInitializationWindow_s = 0.5;
+
+lie::SE3 poseOf(const imu::NavState& state) { return lie::SE3(state.R_world_body, state.p_world); }
+
+}  // namespace
+
+std::unique_ptr<MotionPrior> makeMotionPrior(bool lidar_only, const OdometryConfig& config,
+                                             const RigConfig& rig,
+                                             const ScanPreparation& preparation,
+                                             const registration::RegistrationConfig& registration) {
+  if (lidar_only) return std::make_unique<ConstantVelocityPrior>();
+  return std::make_unique<ImuPrior>(config, rig, preparation, registration);
+}
+
+ImuPrior::ImuPrior(const OdometryConfig& config, const RigConfig& rig,
+                   const ScanPreparation& preparation,
+                   const registration::RegistrationConfig& registration)
+    : config_(config),
+      R_body_imu_(rig.T_body_imu.rotation()),
+      preparation_(preparation),
+      registration_(registration),
+      gravity_odom_(0.0, 0.0, -config.imu.gravity_mps2),
+      smoother_({.gravity_world = gravity_odom_, .window_states = config.window_states}),
+      levelled_(config.gravity_alignment_s <= 0.0) {}
+
+void ImuPrior::addImu(const ImuSample& sample) {
+  // Readings in the body frame; the lever arm of an IMU away from the body origin is not modelled
+  // (the body frame should be the IMU frame, the default).
+  ImuSample in_body = sample;
+  in_body.acceleration_imu_mps2 = R_body_imu_ * sample.acceleration_imu_mps2;
+  in_body.angular_velocity_imu_radps = R_body_imu_ * sample.angular_velocity_imu_radps;
+  if (!imu_.add(in_body))
+    logger().debug("IMU reading at {:.6f} s is not after the previous one; ignored", sample.t_s);
+}
+
+bool ImuPrior::start(const io::Scan& scan, std::optional<FirstScan>& first) {
+  if (smoother_.initialized()) return true;
+  if (imu_.empty() || imu_.lastTime() - imu_.firstTime() < kInitializationWindow_s) {
+    logger().debug("scan {} at {:.3f} s skipped: waiting for {:.1f} s of IMU readings to initialize",
+                   scan.index, scan.t_end_s, kInitializationWindow_s);
+    return false;
+  }
+  if (!first_scan_) {
+    first_scan_ = scan;  // initialization needs the next scan too
+    // The attitude is taken from the readings just before the first scan, not from the start
+    // of a recording whose IMU may have run long before the lidar.
+    imu_.dropBefore(scan.t_start_s - 1.0);
+    return false;
+  }
+  first = initialize(*first_scan_, scan);
+  first_scan_.reset();
+  return true;
+}
+
+std::optional<double> ImuPrior::stateTime() const {
+  if (!smoother_.initialized()) return std::nullopt;
+  return smoother_.latest().t_s;
+}
+
+MotionPrediction ImuPrior::predict(const io::Scan& scan) {
+  const backend::StateEstimate previous = smoother_.latest();
+  MotionPrediction prediction;
+  // The preintegrated increment predicts the pose at the scan's end (and is the IMU factor).
+  preintegrated_.emplace(
+      imu_.preintegrate(previous.t_s, scan.t_end_s, previous.bias, config_.imu));
+  predicted_t_s_ = scan.t_end_s;
+  prediction.T_odom_body =
+      poseOf(preintegrated_->predict(previous.state, previous.bias, gravity_odom_));
+  // Propagation at IMU rate over the sweep (from its start when it began before the state).
+  const double t_from_s = std::min(previous.t_s, scan.t_start_s);
+  const auto states = imu::propagateThrough(previous.state, previous.t_s, scan.t_end_s,
+                                            imu_.between(t_from_s, scan.t_end_s), previous.bias,
+                                            gravity_odom_);
+  for (std::size_t k = 1; k < states.size(); ++k)
+    prediction.imu_rate_poses.push_back({states[k].t_s, poseOf(states[k].state)});
+  prediction.sweep_T_odom_body = imu::toTrajectory(states);
+  return prediction;
+}
+
+MotionUpdate ImuPrior::update(const std::optional<backend::PoseMeasurement>& lidar) {
+  const backend::StateEstimate estimate =
+      smoother_.addState(predicted_t_s_, *preintegrated_, lidar);
+  imu_.dropBefore(estimate.t_s);
+  MotionUpdate update;
+  update.state = {poseOf(estimate.state), estimate.state.v_world, estimate.bias};
+  if (!levelled_) {
+    // The lidar's own pose where registration worked: the alignment must not see the IMU's
+    // (wrongly levelled) prediction; the fused pose otherwise.
+    update.T_odom_unlevelled = collectForAlignment(
+        estimate.t_s, lidar ? lidar->T_world_body : update.state.T_odom_body, &*preintegrated_);
+    if (update.T_odom_unlevelled) {
+      const backend::StateEstimate levelled = smoother_.latest();
+      update.state.T_odom_body = poseOf(levelled.state);
+      update.state.v_odom = levelled.state.v_world;
+    }
+  }
+  preintegrated_.reset();
+  return update;
+}
+
+}  // namespace taiga::pipeline

@@ -1,0 +1,69 @@
+#pragma once
+// The IMU motion model of the lidar-inertial odometry (motion_prior.hpp, thesis 3.1.1 and paper
+// section 2): readings rotated into the body frame, preintegrated between scans for the
+// prediction and the IMU factor, propagated at IMU rate for deskewing and the IMU-rate poses, and
+// a fixed-lag smoother that fuses IMU and lidar factors.
+//
+// Start (imu_prior_start.cpp): the IMU readings give attitude and biases
+// (imu/initialization.hpp); the second scan registered to the first gives the initial velocity.
+// Over the first gravity_alignment_s seconds the lidar poses and the IMU increments then level
+// the odom frame once (imu/gravity_alignment.hpp): a start while moving gets its tilt from the
+// data rather than from the mean specific force. imu:: and backend:: call the frame they
+// integrate in `world`: here it is the odom frame. Internal to the pipeline.
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "motion_prior.hpp"
+#include "taiga/imu/initialization.hpp"
+#include "taiga/pipeline/imu_buffer.hpp"
+
+namespace taiga::pipeline {
+
+class ImuPrior final : public MotionPrior {
+ public:
+  ImuPrior(const OdometryConfig& config, const RigConfig& rig, const ScanPreparation& preparation,
+           const registration::RegistrationConfig& registration);
+
+  void addImu(const ImuSample& sample) override;
+  bool start(const io::Scan& scan, std::optional<FirstScan>& first) override;
+  std::optional<double> stateTime() const override;
+  MotionPrediction predict(const io::Scan& scan) override;
+  bool boundsJumps() const override { return true; }
+  MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) override;
+  bool levelled() const override { return levelled_; }
+  const std::string& initializationNote() const override { return initialization_note_; }
+
+ private:
+  /// Attitude and biases from the IMU readings, and the time the state starts at.
+  std::pair<imu::InitialState, double> initialAttitude(const io::Scan& first);
+  /// The first scan's state from the IMU's attitude and the velocity between the first two.
+  FirstScan initialize(const io::Scan& first, const io::Scan& second);
+  /// A pose for the gravity alignment; levels the frame when its span is covered.
+  std::optional<lie::SE3> collectForAlignment(double t_s, const lie::SE3& T_unlevelled_body,
+                                              const imu::Preintegrator* increment);
+  /// Levels the frame with the collected poses; returns T_levelled_unlevelled, or none when the
+  /// alignment is not trusted (the IMU's attitude is kept).
+  std::optional<lie::SE3> levelFrame();
+
+  OdometryConfig config_;
+  lie::SO3 R_body_imu_;
+  const ScanPreparation& preparation_;
+  const registration::RegistrationConfig& registration_;
+  Eigen::Vector3d gravity_odom_;
+  ImuBuffer imu_;  ///< readings in the body frame
+  backend::OdometrySmoother smoother_;
+  std::optional<io::Scan> first_scan_;  ///< held until the second scan arrives
+  /// The scan last predicted: its end time and the increment since the previous state.
+  double predicted_t_s_ = 0.0;
+  std::optional<imu::Preintegrator> preintegrated_;
+  std::string initialization_note_;
+  bool levelled_ = false;
+  std::vector<double> alignment_times_;
+  std::vector<lie::SE3> alignment_poses_;
+  std::vector<imu::Preintegrator> alignment_increments_;
+};
+
+}  // namespace taiga::pipeline

@@ -1,0 +1,63 @@
+#include "lidar_factor.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "taiga/core/angles.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+std::string rejection(const registration::RegistrationResult& r,
+                      const lie::SE3& predicted_T_odom_body, bool check_jump,
+                      const OdometryConfig& config) {
+  const lie::Vector6 jump = (predicted_T_odom_body.inverse() * r.T_target_source).Log();
+  const double jump_m = jump.head<3>().norm(), jump_deg = jump.tail<3>().norm() / kRadPerDeg;
+  if (r.iterations == 0 || r.num_inliers == 0 || !std::isfinite(r.hessian_condition))
+    return "registration failed: " + r.reason;
+  if (!std::isfinite(r.fitness_m2) || r.fitness_m2 > config.max_fitness_m2)
+    return fmt::format("fitness {:.3f} m^2 above {:.3f}", r.fitness_m2, config.max_fitness_m2);
+  if (check_jump && (jump_m > config.max_jump_m || jump_deg > config.max_jump_deg))
+    return fmt::format("{:.3f} m / {:.2f} deg from the IMU prediction", jump_m, jump_deg);
+  return {};
+}
+
+}  // namespace
+
+LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
+                                     const lie::SE3& predicted_T_odom_body, bool check_jump,
+                                     const OdometryConfig& config) {
+  LidarFactorVerdict verdict;
+  verdict.note = rejection(r, predicted_T_odom_body, check_jump, config);
+  if (!verdict.note.empty()) return verdict;
+  // Thesis Eq. 36 (OdometryConfig::lidarSigmas, docs/odometry.md), ten times wider when the
+  // registration did not converge or is degenerate.
+  double inflation = 1.0;
+  verdict.factor = LidarFactor::kUsed;
+  if (!r.converged || r.hessian_condition > config.degenerate_condition) {
+    inflation = 10.0;
+    verdict.factor = LidarFactor::kInflated;
+    verdict.note = !r.converged ? "registration hit its iteration limit"
+                                : fmt::format("degenerate: Hessian condition {:.3g}",
+                                              r.hessian_condition);
+  }
+  // Roll and pitch keep sigma_sm: gravity in the IMU factor observes them, and a tighter lidar
+  // factor would hold on to a tilted local map. Heading has no such second source, so it gets its
+  // own, tighter sigma (docs/odometry.md). The factor's rotation tangent is in the body frame:
+  // Sigma_body = R^T Sigma_odom R.
+  const LidarSigmas sigma = config.lidarSigmas(r.fitness_m2, inflation);
+  const Eigen::Matrix3d R_odom_body = r.T_target_source.rotation().matrix();
+  const Eigen::Vector3d rotation_variances_odom(sigma.tilt_rad * sigma.tilt_rad,
+                                                sigma.tilt_rad * sigma.tilt_rad,
+                                                sigma.heading_rad * sigma.heading_rad);
+  lie::Matrix6 covariance = lie::Matrix6::Zero();
+  covariance.topLeftCorner<3, 3>() =
+      Eigen::Matrix3d::Identity() * sigma.translation_m * sigma.translation_m;
+  covariance.bottomRightCorner<3, 3>() =
+      R_odom_body.transpose() * rotation_variances_odom.asDiagonal() * R_odom_body;
+  verdict.measurement = backend::PoseMeasurement{r.T_target_source, covariance};
+  return verdict;
+}
+
+}  // namespace taiga::pipeline

@@ -1,0 +1,193 @@
+#include "taiga/pipeline/odometry.hpp"
+
+#include <chrono>
+
+#include "lidar_factor.hpp"
+#include "motion_prior.hpp"
+#include "scan_preparation.hpp"
+#include "taiga/core/log.hpp"
+#include "taiga/preprocess/voxel_filter.hpp"
+#include "taiga/registration/kdtree.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// The local map's NDT passes, coarse to fine. The IMU predicts within centimetres: the fine
+/// cells' basin suffices. The constant-velocity prediction of lidar-only odometry may be off by
+/// decimetres: coarse to fine.
+std::vector<double> localMapResolutionsM(const OdometryConfig& config, bool lidar_only) {
+  if (lidar_only) return config.ndtResolutionsM();
+  return {config.ndt_resolution_m};
+}
+
+}  // namespace
+
+const char* lidarFactorName(LidarFactor factor) {
+  switch (factor) {
+    case LidarFactor::kFirstScan:
+      return "first_scan";
+    case LidarFactor::kUsed:
+      return "used";
+    case LidarFactor::kInflated:
+      return "inflated";
+    case LidarFactor::kRejected:
+      return "rejected";
+  }
+  return "?";
+}
+
+Odometry::Odometry(const OdometryConfig& config, const RigConfig& rig, bool lidar_only)
+    : config_(config),
+      lidar_only_(lidar_only),
+      registration_(registration::registrationConfigFor(config)),
+      preparation_(std::make_unique<ScanPreparation>(config, rig)),
+      motion_(makeMotionPrior(lidar_only, config, rig, *preparation_, registration_)),
+      local_map_(localMapResolutionsM(config, lidar_only), config.local_map_voxel_m,
+                 config.local_map_keyframes,
+                 registration_.method == registration::Method::kGicp ? LocalMap::Target::kGicp
+                                                                     : LocalMap::Target::kNdt) {}
+
+Odometry::~Odometry() = default;
+
+void Odometry::addImu(const ImuSample& sample) { motion_->addImu(sample); }
+
+void Odometry::setMovingBoxes(MovingBoxes boxes_body) {
+  preparation_->setMovingBoxes(std::move(boxes_body));
+}
+
+bool Odometry::odomFrameFinal() const { return motion_->levelled(); }
+
+const std::string& Odometry::initializationNote() const { return motion_->initializationNote(); }
+
+std::vector<ScanOutcome> Odometry::addScan(const io::Scan& scan) {
+  std::vector<ScanOutcome> outcomes;
+  std::optional<FirstScan> first;
+  if (!motion_->start(scan, first)) return outcomes;
+  if (first) outcomes.push_back(firstScanOutcome(std::move(*first)));
+  if (std::optional<ScanOutcome> outcome = processScan(scan))
+    outcomes.push_back(std::move(*outcome));
+  return outcomes;
+}
+
+ScanOutcome Odometry::firstScanOutcome(FirstScan&& first) {
+  ScanOutcome outcome;
+  outcome.scan_index = first.index;
+  outcome.t_s = first.t_s;
+  outcome.T_odom_body = first.state.T_odom_body;
+  outcome.v_odom = first.state.v_odom;
+  outcome.bias = first.state.bias;
+  outcome.lidar = LidarFactor::kFirstScan;
+  maybeAddKeyframe(outcome, first.cloud_in_body);
+  return outcome;
+}
+
+std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
+  const auto start = Clock::now();
+  if (const std::optional<double> t_state_s = motion_->stateTime();
+      t_state_s && scan.t_end_s <= *t_state_s) {
+    logger().warn("scan {} ends at {:.6f} s, not after the previous state at {:.6f} s; skipped",
+                  scan.index, scan.t_end_s, *t_state_s);
+    return std::nullopt;
+  }
+  ScanOutcome outcome;
+  outcome.scan_index = scan.index;
+  outcome.t_s = scan.t_end_s;
+
+  // 1. Predict; 2. deskew into the body frame at the scan's end.
+  MotionPrediction prediction = motion_->predict(scan);
+  outcome.imu_rate_poses = std::move(prediction.imu_rate_poses);
+  const PointCloud cloud_in_body = preparation_->deskewedInBody(scan, prediction.sweep_T_odom_body);
+  outcome.timing.deskew_ms = msSince(start);
+
+  // 3. Voxel filter.
+  auto stage = Clock::now();
+  const PointCloud source_cloud = preprocess::voxelFilter(cloud_in_body, config_.voxel_size_m);
+  outcome.source_points = source_cloud.size();
+  outcome.timing.filter_ms = msSince(stage);
+
+  // 4. Register to the local map (none before the first keyframe without an IMU).
+  stage = Clock::now();
+  const bool has_map = !local_map_.empty();
+  if (has_map) outcome.registration = registerToMap(source_cloud.positions, prediction.T_odom_body);
+  outcome.timing.registration_ms = msSince(stage);
+
+  // 5. Judge it; 6. fuse it with the motion prior.
+  stage = Clock::now();
+  LidarFactorVerdict verdict{.factor = LidarFactor::kFirstScan};
+  if (has_map)
+    verdict = judgeRegistration(outcome.registration, prediction.T_odom_body,
+                                motion_->boundsJumps(), config_);
+  outcome.lidar = verdict.factor;
+  outcome.lidar_note = verdict.note;
+  const MotionUpdate update = motion_->update(verdict.measurement);
+  outcome.T_odom_body = update.state.T_odom_body;
+  outcome.v_odom = update.state.v_odom;
+  outcome.bias = update.state.bias;
+  if (update.T_odom_unlevelled) {
+    // The keyframes so far were deskewed with the velocity still unknown (zero at the start): the
+    // local map starts over from this scan, deskewed with the velocity the odometry has found.
+    local_map_.clear();
+    last_keyframe_T_odom_body_.reset();
+    for (StampedPose& p : outcome.imu_rate_poses) p.pose = *update.T_odom_unlevelled * p.pose;
+    outcome.T_odom_unlevelled = update.T_odom_unlevelled;
+  }
+  outcome.timing.optimization_ms = msSince(stage);
+
+  // 7. Keyframe.
+  stage = Clock::now();
+  maybeAddKeyframe(outcome, cloud_in_body);
+  outcome.timing.map_ms = msSince(stage);
+  outcome.timing.total_ms = msSince(start);
+  return outcome;
+}
+
+registration::RegistrationResult Odometry::registerToMap(const std::vector<Eigen::Vector3d>& source,
+                                                         const lie::SE3& guess_T_odom_body) {
+  local_map_.beginRegistration();
+  registration::RegistrationResult result;
+  if (registration_.method == registration::Method::kGicp) {
+    result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),
+                                     guess_T_odom_body, {});
+  } else {
+    // Coarse to fine: each pass starts from the previous one's pose.
+    lie::SE3 guess = guess_T_odom_body;
+    int iterations = 0;
+    for (const registration::NdtTarget* target : local_map_.ndtTargets()) {
+      result = registration_.method == registration::Method::kD2dNdt
+                   ? registration::alignD2dNdt(source, *target, guess, registration_.ndt)
+                   : registration::alignNdt(source, *target, guess, registration_.ndt);
+      iterations += result.iterations;
+      if (result.num_inliers == 0) break;
+      guess = result.T_target_source;
+    }
+    result.iterations = iterations;
+  }
+  // Points farther than a few coarse NDT cells from the map are new ground, not misalignment.
+  result.fitness_m2 = registration::fitnessScore(
+      source, local_map_.kdTree(), result.T_target_source, 2.0 * config_.coarsestNdtResolutionM());
+  return result;
+}
+
+void Odometry::maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body) {
+  if (last_keyframe_T_odom_body_) {
+    const lie::Vector6 moved = (last_keyframe_T_odom_body_->inverse() * outcome.T_odom_body).Log();
+    const double travelled_m =
+        (outcome.T_odom_body.translation() - last_keyframe_T_odom_body_->translation()).norm() +
+        config_.keyframe_rotation_weight_m_per_rad * moved.tail<3>().norm();
+    if (travelled_m < config_.keyframe_distance_m) return;
+  }
+  outcome.keyframe = true;
+  last_keyframe_T_odom_body_ = outcome.T_odom_body;
+  local_map_.addKeyframe(
+      outcome.t_s, outcome.T_odom_body,
+      preprocess::voxelFilter(cloud_in_body, config_.local_map_voxel_m).positions);
+  outcome.keyframe_cloud_in_body = cloud_in_body;
+}
+
+}  // namespace taiga::pipeline

@@ -1,0 +1,93 @@
+#include <fmt/format.h>
+
+#include <nlohmann/json.hpp>
+
+#include "run_outputs.hpp"
+#include "taiga/core/angles.hpp"
+
+namespace taiga::pipeline {
+
+// GNSS fused in the mapping graph (mapping.gnss_fusion): what became of the fixes and the
+// graph's T_enu_map (docs/mapping.md).
+namespace {
+
+nlohmann::ordered_json gnssFusionJson(const mapping::GnssFusionReport& r) {
+  nlohmann::ordered_json j = {
+      {"fixes", r.total},     {"gated", r.gated}, {"outside_keyframes", r.outside},
+      {"waiting", r.waiting}, {"used", r.used},   {"down_weighted", r.down_weighted}};
+  if (r.enu_origin)
+    j["enu_origin"] = {{"latitude_deg", r.enu_origin->latitude_deg},
+                       {"longitude_deg", r.enu_origin->longitude_deg},
+                       {"height_ellipsoid_m", r.enu_origin->height_m}};
+  if (r.T_enu_map) {
+    const Eigen::Matrix4d T = r.T_enu_map->matrix();
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    for (int i = 0; i < 4; ++i) rows.push_back({T(i, 0), T(i, 1), T(i, 2), T(i, 3)});
+    j["T_enu_map"] = rows;
+    j["yaw_enu_map_deg"] = r.T_enu_map->rotation().yaw() * kDegPerRad;
+  }
+  return j;
+}
+
+}  // namespace
+
+void writeSummary(const std::filesystem::path& path, const RunSummary& s,
+                  const std::filesystem::path& recording,
+                  const std::optional<mapping::GnssFusionReport>& gnss_fusion) {
+  nlohmann::ordered_json j = {
+      {"recording", recording.string()},
+      {"scans", s.scans},
+      {"scans_processed", s.scans_processed},
+      {"imu_samples", s.imu_samples},
+      {"keyframes", s.keyframes},
+      {"loop_closures", s.loop_closures},
+      {"odometry_corrections",
+       {{"local_map_rebuilds", s.local_map_rebuilds}, {"wait_s", s.odometry_correction_wait_s}}},
+      {"lidar_factors_rejected", s.lidar_rejected},
+      {"lidar_factors_inflated", s.lidar_inflated},
+      {"map_points", s.map_points},
+      {"duration_s", s.duration_s},
+      {"path_length_m", s.path_length_m},
+      {"time_per_scan_ms",
+       {{"mean", s.mean_ms}, {"p50", s.median_ms}, {"p95", s.p95_ms}, {"max", s.max_ms}}},
+      {"wall_time_s", s.wall_time_s},
+      {"map_export_s", s.map_export_s},
+      {"realtime_factor", s.realtime_factor},
+      {"peak_memory_mb", s.peak_memory_mb},
+      {"initialization", s.initialization},
+  };
+  if (s.realtime) {
+    j["realtime"] = {{"dropped_scans", s.realtime->dropped_scans},
+                     {"latency_ms",
+                      {{"p50", s.realtime->latency_p50_ms},
+                       {"p95", s.realtime->latency_p95_ms},
+                       {"max", s.realtime->latency_max_ms}}}};
+  }
+  if (s.georef) {
+    const GeorefRunReport& g = *s.georef;
+    nlohmann::ordered_json georef = {{"fixes", g.fixes}};
+    if (!g.skipped.empty()) {
+      georef["skipped"] = g.skipped;
+    } else {
+      georef.update({{"method", g.method},
+                     {"epsg", g.epsg},
+                     {"inliers", g.inliers},
+                     {"outliers", g.outliers},
+                     {"horizontal_rms_m", g.horizontal_rms_m},
+                     {"vertical_rms_m", g.vertical_rms_m},
+                     {"sigma",
+                      {{"east_m", g.sigma[0]},
+                       {"north_m", g.sigma[1]},
+                       {"up_m", g.sigma[2]},
+                       {"roll_deg", g.sigma[3] * kDegPerRad},
+                       {"pitch_deg", g.sigma[4] * kDegPerRad},
+                       {"yaw_deg", g.sigma[5] * kDegPerRad}}},
+                     {"map_export_s", g.map_export_s}});
+    }
+    j["georef"] = georef;
+  }
+  if (gnss_fusion) j["gnss_fusion"] = gnssFusionJson(*gnss_fusion);
+  openOutput(path) << j.dump(2) << "\n";
+}
+
+}  // namespace taiga::pipeline
