@@ -1,16 +1,20 @@
 // The mapping back end's loop handling on synthetic keyframes: Mapper with a stand-in verifier
 // (loops consistent with the odometry are kept and pull the graph, false ones are refused by the
-// chi^2 test, attempts are paced by keyframe time, none with loop closure off).
+// chi^2 test, attempts are paced by keyframe time, none with loop closure off), and MappingThread
+// against an inline Mapper on a small synthetic forest with the real verifier (the same map,
+// the same snapshots).
 #include "taiga/mapping/mapper.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "../support/temp_dir.hpp"
+#include "synthetic_forest.hpp"
 #include "taiga/core/angles.hpp"
 
 namespace taiga::mapping {
@@ -191,6 +195,93 @@ TEST_F(MapperWithAStandInVerifier, MakesNoAttemptWithLoopClosureOff) {
   EXPECT_TRUE(mapper.loopAttempts().empty());
   EXPECT_EQ(mapper.loopClosures(), 0u);
   EXPECT_LT(distanceM(mapper.graph().pose(159), T_odom_body_[159]), 1e-9);
+}
+
+// ---------------------------------------------------------------------------------------------
+// MappingThread against an inline Mapper, with the real verifier on a synthetic forest
+
+// One and a half laps of a 40 m circle in a forest (keyframes 1 m and 1 s apart) whose odometry
+// drifts 0.02 deg/m in heading with 0.3 % long steps; scans stored at the true poses.
+class MappingOnAForest : public ::testing::Test {
+ protected:
+  MappingOnAForest() {
+    config_.loop_exclude_recent_keyframes = 10;
+    config_.loop_submap_keyframes = 3;
+    const std::vector<lie::SE3> T_world_body_true = forest::circlePath(60);
+    const std::vector<Eigen::Vector3d> forest_in_world = forest::forestInWorld(1);
+    T_odom_body_.push_back(T_world_body_true.front());
+    for (std::size_t k = 1; k < T_world_body_true.size(); ++k) {
+      const lie::SE3 step = T_world_body_true[k - 1].inverse() * T_world_body_true[k];
+      T_odom_body_.push_back(
+          T_odom_body_.back() *
+          lie::SE3(step.rotation() * lie::SO3::Exp(Eigen::Vector3d(0, 0, 0.02 * kRadPerDeg)),
+                   step.translation() * 1.003));
+    }
+    for (std::size_t k = 0; k < T_world_body_true.size(); ++k)
+      store_.add(secondsOf(k), T_odom_body_[k],
+                 forest::scanInBody(forest_in_world, T_world_body_true[k],
+                                    100 + static_cast<unsigned>(k)));
+  }
+
+  MappingConfig config_;
+  const OdometryConfig odometry_;
+  const taiga::test::TempDir dir_;
+  KeyframeStore store_ =
+      KeyframeStore::create(dir_.path(), {.registration_voxel_m = odometry_.voxel_size_m});
+  std::vector<lie::SE3> T_odom_body_;
+};
+
+void expectSamePoses(const std::vector<lie::SE3>& a, const std::vector<lie::SE3>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].translation(), b[k].translation()) << k;
+    EXPECT_EQ(a[k].rotation().quaternion().coeffs(), b[k].rotation().quaternion().coeffs()) << k;
+  }
+}
+
+TEST_F(MappingOnAForest, TheThreadGivesTheInlineMapperResultBitForBit) {
+  Mapper inline_mapper(config_, odometry_, store_);
+  MappingThread thread(config_, odometry_, store_);
+  for (std::size_t k = 0; k < T_odom_body_.size(); ++k) {
+    inline_mapper.addKeyframe(k, secondsOf(k), T_odom_body_[k]);
+    thread.addKeyframe(k, secondsOf(k), T_odom_body_[k]);
+  }
+  inline_mapper.finish();
+  const Mapper& threaded = thread.finish();
+
+  ASSERT_GE(inline_mapper.loopClosures(), 1u);  // the real verifier closed loops
+  EXPECT_EQ(threaded.loopClosures(), inline_mapper.loopClosures());
+  ASSERT_EQ(threaded.loopAttempts().size(), inline_mapper.loopAttempts().size());
+  for (std::size_t i = 0; i < inline_mapper.loopAttempts().size(); ++i) {
+    const LoopRecord& a = inline_mapper.loopAttempts()[i];
+    const LoopRecord& b = threaded.loopAttempts()[i];
+    EXPECT_EQ(a.attempt.current, b.attempt.current) << i;
+    EXPECT_EQ(a.attempt.accepted, b.attempt.accepted) << i;
+    EXPECT_EQ(a.chi2, b.chi2) << i;
+  }
+  expectSamePoses(threaded.graph().poses(), inline_mapper.graph().poses());
+}
+
+TEST_F(MappingOnAForest, EachSnapshotHoldsTheGraphsNewestPosesAfterItsKeyframe) {
+  constexpr std::size_t kSnapshotKeyframes = 3;
+  Mapper inline_mapper(config_, odometry_, store_);
+  MappingThread thread(config_, odometry_, store_, {.snapshot_keyframes = kSnapshotKeyframes});
+  bool a_loop_moved_the_newest_poses = false;
+  for (std::size_t k = 0; k < T_odom_body_.size(); ++k) {
+    inline_mapper.addKeyframe(k, secondsOf(k), T_odom_body_[k]);
+    thread.addKeyframe(k, secondsOf(k), T_odom_body_[k]);
+    const std::optional<GraphSnapshot> snapshot = thread.waitForSnapshot(k);
+    ASSERT_TRUE(snapshot.has_value()) << k;
+    EXPECT_EQ(snapshot->keyframe, k);
+    const std::vector<lie::SE3>& poses = inline_mapper.graph().poses();
+    const std::size_t count = std::min(kSnapshotKeyframes, poses.size());
+    expectSamePoses(snapshot->poses_T_world_body,
+                    std::vector<lie::SE3>(poses.end() - count, poses.end()));
+    if (distanceM(snapshot->poses_T_world_body.back(), T_odom_body_[k]) > 0.05)
+      a_loop_moved_the_newest_poses = true;
+  }
+  EXPECT_TRUE(a_loop_moved_the_newest_poses);
+  thread.finish();
 }
 
 }  // namespace
