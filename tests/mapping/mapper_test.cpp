@@ -275,9 +275,9 @@ TEST_F(MappingOnAForest, EachSnapshotHoldsTheGraphsNewestPosesAfterItsKeyframe) 
     EXPECT_EQ(snapshot->keyframe, k);
     const std::vector<lie::SE3>& poses = inline_mapper.graph().poses();
     const std::size_t count = std::min(kSnapshotKeyframes, poses.size());
-    expectSamePoses(snapshot->poses_T_world_body,
+    expectSamePoses(snapshot->poses_T_map_body,
                     std::vector<lie::SE3>(poses.end() - count, poses.end()));
-    if (distanceM(snapshot->poses_T_world_body.back(), T_odom_body_[k]) > 0.05)
+    if (distanceM(snapshot->poses_T_map_body.back(), T_odom_body_[k]) > 0.05)
       a_loop_moved_the_newest_poses = true;
   }
   EXPECT_TRUE(a_loop_moved_the_newest_poses);
