@@ -52,8 +52,6 @@ class LocalMap {
                   T_odom_keyframe_at);
   /// Drops every keyframe.
   void clear();
-  /// Replaces the NDT passes (coarse to fine, at least one); only while the map is empty.
-  void setNdtResolutions(const std::vector<double>& ndt_resolutions_m);
   /// Call once before each registration: hands the background build over when its turn has come
   /// (at once when there was no map before).
   void beginRegistration();
@@ -68,6 +66,8 @@ class LocalMap {
   const registration::GicpCloud& gicpCloud() const;
 
  private:
+  /// Sets the NDT passes (coarse to fine, at least one); only while the map is empty.
+  void setNdtResolutions(const std::vector<double>& ndt_resolutions_m);
   struct SearchStructures {
     std::vector<std::unique_ptr<registration::NdtTarget>> ndt_targets;  ///< coarse to fine
     std::unique_ptr<registration::GicpCloud> gicp_cloud;
