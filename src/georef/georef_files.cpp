@@ -8,8 +8,8 @@
 
 #include <cctype>
 #include <cmath>
-#include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/io/recording.hpp"
 
@@ -87,9 +87,8 @@ void writeGeoJson(const std::filesystem::path& path, const std::vector<GridPose>
 }
 
 void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& report) {
-  constexpr double kDeg = 180.0 / std::numbers::pi;
   const GeorefFit& fit = report.fit;
-  const Eigen::Vector3d rpy_deg = rollPitchYaw(fit.T_enu_world.rotation()) * kDeg;
+  const Eigen::Vector3d rpy_deg = rollPitchYaw(fit.T_enu_world.rotation()) * kDegPerRad;
   auto out = fmt::output_file(path.string());
   out.print("# taiga georef: where the trajectory's world frame lies (docs/georeferencing.md)\n");
   out.print("method: {}\ntrajectory: {}\ngnss: {}\n", report.method, jsonString(report.trajectory_file),
@@ -109,12 +108,12 @@ void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& repo
             report.epsg);
   out.print("T_epsg_world:\n{}", matrixRows(report.T_epsg_world, "  "));
   out.print("yaw_grid_world_deg: {}\n",
-            std::atan2(report.T_epsg_world(1, 0), report.T_epsg_world(0, 0)) * kDeg);
+            std::atan2(report.T_epsg_world(1, 0), report.T_epsg_world(0, 0)) * kDegPerRad);
   out.print("# 1-sigma of T_enu_world: translation in ENU (m), small rotations about east (roll),\n"
             "# north (pitch) and up (yaw) (deg); from the normal equations scaled by the residuals\n");
   out.print("sigma:\n  east_m: {}\n  north_m: {}\n  up_m: {}\n", fit.sigma[0], fit.sigma[1], fit.sigma[2]);
-  out.print("  roll_deg: {}\n  pitch_deg: {}\n  yaw_deg: {}\n", fit.sigma[3] * kDeg,
-            fit.sigma[4] * kDeg, fit.sigma[5] * kDeg);
+  out.print("  roll_deg: {}\n  pitch_deg: {}\n  yaw_deg: {}\n", fit.sigma[3] * kDegPerRad,
+            fit.sigma[4] * kDegPerRad, fit.sigma[5] * kDegPerRad);
   out.print("fixes:\n  total: {}\n  gated_no_fix: {}\n  gated_sigma: {}\n  gated_invalid: {}\n",
             report.fixes_total, report.gated_no_fix, report.gated_sigma, report.gated_invalid);
   out.print("  outside_trajectory: {}\n  in_trajectory_gap: {}\n  associated: {}\n",

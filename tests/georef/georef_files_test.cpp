@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "../support/temp_dir.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/georef/georef_files.hpp"
 
@@ -94,8 +95,8 @@ TEST(GeorefYaml, HoldsTheTransformsSigmasAndCountsAtFullPrecision) {
   EXPECT_EQ(yaml["enu_origin"]["latitude_deg"].as<double>(), 61.000000123456789);
   EXPECT_EQ(yaml["T_enu_world"][0][3].as<double>(), 1.0 / 3.0);
   EXPECT_EQ(yaml["T_epsg_world"][0][3].as<double>(), 364808.14192166715);
-  EXPECT_NEAR(yaml["T_enu_world_roll_pitch_yaw_deg"][2].as<double>(), 0.3 * 180.0 / M_PI, 1e-12);
-  EXPECT_NEAR(yaml["sigma"]["yaw_deg"].as<double>(), 0.003 * 180.0 / M_PI, 1e-12);
+  EXPECT_NEAR(yaml["T_enu_world_roll_pitch_yaw_deg"][2].as<double>(), 0.3 * kDegPerRad, 1e-12);
+  EXPECT_NEAR(yaml["sigma"]["yaw_deg"].as<double>(), 0.003 * kDegPerRad, 1e-12);
   EXPECT_EQ(yaml["sigma"]["north_m"].as<double>(), 0.2);
   EXPECT_EQ(yaml["fixes"]["total"].as<int>(), 50);
   EXPECT_EQ(yaml["fixes"]["gated_sigma"].as<int>(), 8);
