@@ -96,7 +96,7 @@ InitialState initializeFromImu(std::span<const ImuSample> samples,
 
   const Matrix3 R = init.state.R_world_body.matrix();
   const Vector3 rpy_deg =
-      Vector3(std::atan2(R(2, 1), R(2, 2)), -std::asin(R(2, 0)), std::atan2(R(1, 0), R(0, 0))) *
+      Vector3(std::atan2(R(2, 1), R(2, 2)), -std::asin(R(2, 0)), init.state.R_world_body.yaw()) *
       kDegPerRad;
   init.description = fmt::format(
       "{}{}: roll {:.2f} deg, pitch {:.2f} deg, yaw {:.2f} deg from {} readings over {:.2f} s",

@@ -77,9 +77,8 @@ GeorefErrors scoreAgainstTruth(const std::filesystem::path& sim_dir,
         errors.max_horizontal_m, std::hypot(values[1] - truth_grid.x(), values[2] - truth_grid.y()));
     errors.mean_height_m += values[3] - truth_grid.z();
     errors.max_height_m = std::max(errors.max_height_m, std::abs(values[3] - truth_grid.z()));
-    const Eigen::Vector3d x_world = pose.pose.rotation().matrix().col(0);
-    const double truth_yaw_deg = std::atan2(x_world.y(), x_world.x()) * kDegPerRad +
-                                 truth["yaw_grid_world_deg"].as<double>();
+    const double truth_yaw_deg =
+        pose.pose.rotation().yaw() * kDegPerRad + truth["yaw_grid_world_deg"].as<double>();
     errors.max_yaw_column_deg = std::max(
         errors.max_yaw_column_deg, std::abs(std::remainder(values[4] - truth_yaw_deg, 360.0)));
     ++rows;
@@ -323,9 +322,8 @@ TEST(GeorefCli, TaigaRunGeoreferencesItsTrajectoryAndMapWhenTheRecordingHasFixes
     max_horizontal_m = std::max(max_horizontal_m, std::hypot(v[1] - truth_grid.x(),
                                                              v[2] - truth_grid.y()));
     max_height_m = std::max(max_height_m, std::abs(v[3] - truth_grid.z()));
-    const Eigen::Vector3d x_simworld = T_simworld_body.rotation().matrix().col(0);
-    const double truth_yaw_deg = std::atan2(x_simworld.y(), x_simworld.x()) * kDegPerRad +
-                                 truth["yaw_grid_world_deg"].as<double>();
+    const double truth_yaw_deg =
+        T_simworld_body.rotation().yaw() * kDegPerRad + truth["yaw_grid_world_deg"].as<double>();
     max_yaw_deg = std::max(max_yaw_deg, std::abs(std::remainder(v[4] - truth_yaw_deg, 360.0)));
     min_e = std::min(min_e, v[1]), max_e = std::max(max_e, v[1]);
     min_n = std::min(min_n, v[2]), max_n = std::max(max_n, v[2]);
