@@ -30,12 +30,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
-#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "../tests/registration/forest_case.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/preprocess/deskew.hpp"
 #include "taiga/preprocess/voxel_filter.hpp"
@@ -81,7 +81,7 @@ Measurement measure(int runs, const lie::SE3& truth,
     times.push_back(msSince(start));
     const lie::SE3 delta = truth.inverse() * T;
     m.error_m = delta.translation().norm();
-    m.error_deg = delta.rotation().Log().norm() * 180.0 / std::numbers::pi;
+    m.error_deg = delta.rotation().Log().norm() * kDegPerRad;
     m.iterations = iterations;
   }
   std::sort(times.begin(), times.end());
@@ -189,10 +189,10 @@ int main(int argc, char** argv) {
   // real-pair benchmark's 0.5 m / 5 deg.
   const Guess guesses[] = {
       {"odometry-like guess: 0.1 m along (1,1,0), 1 deg about (0.3,0.2,1)",
-       truth * lie::SE3(lie::SO3::fromAxisAngle({0.3, 0.2, 1.0}, 1.0 * std::numbers::pi / 180),
+       truth * lie::SE3(lie::SO3::fromAxisAngle({0.3, 0.2, 1.0}, 1.0 * kRadPerDeg),
                         Eigen::Vector3d(1.0, 1.0, 0.0).normalized() * 0.1)},
       {"large guess: 0.5 m along (1,1,0), 5 deg about (0.3,0.2,1)",
-       truth * lie::SE3(lie::SO3::fromAxisAngle({0.3, 0.2, 1.0}, 5.0 * std::numbers::pi / 180),
+       truth * lie::SE3(lie::SO3::fromAxisAngle({0.3, 0.2, 1.0}, 5.0 * kRadPerDeg),
                         Eigen::Vector3d(1.0, 1.0, 0.0).normalized() * 0.5)},
   };
   for (const Guess& g : guesses) {

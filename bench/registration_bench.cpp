@@ -18,10 +18,10 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <numbers>
 #include <string>
 #include <vector>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/registration/gicp.hpp"
 #include "taiga/registration/ndt.hpp"
@@ -72,7 +72,7 @@ Measurement measure(int runs, const lie::SE3& reference,
     times.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
     const lie::SE3 delta = reference.inverse() * T;
     m.error_m = delta.translation().norm();
-    m.error_deg = delta.rotation().Log().norm() * 180.0 / std::numbers::pi;
+    m.error_deg = delta.rotation().Log().norm() * kDegPerRad;
     m.iterations = iterations;
   }
   std::sort(times.begin(), times.end());
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   // The same initial error for every method: 0.5 m along (1, 1, 0)/sqrt 2 and 5 deg about
   // (0.3, 0.2, 1) normalized, applied on the source side.
   const lie::SE3 guess =
-      reference * lie::SE3(lie::SO3::fromAxisAngle({0.3, 0.2, 1.0}, 5.0 * std::numbers::pi / 180),
+      reference * lie::SE3(lie::SO3::fromAxisAngle({0.3, 0.2, 1.0}, 5.0 * kRadPerDeg),
                            Eigen::Vector3d(1.0, 1.0, 0.0).normalized() * 0.5);
   const Eigen::Matrix4f guess_f = guess.matrix().cast<float>();
 

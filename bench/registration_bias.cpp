@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/io/config_yaml.hpp"
@@ -104,7 +105,7 @@ std::vector<Eigen::Vector3d> mapInWorld(const std::vector<TrueScan>& scans,
                                         const std::vector<lie::SE3>& T_world_keyframe,
                                         const Eigen::Vector3d& viewpoint_world,
                                         double max_view_angle_deg) {
-  const double min_cos = std::cos(max_view_angle_deg * M_PI / 180.0);
+  const double min_cos = std::cos(max_view_angle_deg * kRadPerDeg);
   std::vector<Eigen::Vector3d> points;
   for (std::size_t j = 0; j < keyframes.size(); ++j) {
     const lie::SE3& T = T_world_keyframe[j];

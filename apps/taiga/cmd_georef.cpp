@@ -9,6 +9,7 @@
 
 #include "command.hpp"
 #include "recording_options.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/georef/georeference.hpp"
 #include "taiga/io/trajectory_io.hpp"
@@ -40,17 +41,17 @@ int runGeoref(const GeorefOptions& options) {
 
   const georef::GeorefReport& report = georeference.report;
   const georef::GeorefFit& result = report.fit;
-  constexpr double kDeg = 57.29577951308232;
   fmt::print("georef {}: {} of {} fixes used ({} gated, {} outside the trajectory, {} outliers), "
              "residual RMS {:.2f} m horizontal, {:.2f} m vertical\n",
              report.method, result.inliers, report.fixes_total,
              report.gated_no_fix + report.gated_sigma + report.gated_invalid,
              report.outside_span + report.in_gap, result.outliers, result.horizontal_rms_m,
              result.vertical_rms_m);
-  fmt::print("1-sigma: east {:.3f} m, north {:.3f} m, up {:.3f} m, roll {:.3f} deg, pitch {:.3f} "
-             "deg, yaw {:.3f} deg\n",
-             result.sigma[0], result.sigma[1], result.sigma[2], result.sigma[3] * kDeg,
-             result.sigma[4] * kDeg, result.sigma[5] * kDeg);
+  fmt::print(
+      "1-sigma: east {:.3f} m, north {:.3f} m, up {:.3f} m, roll {:.3f} deg, pitch {:.3f} "
+      "deg, yaw {:.3f} deg\n",
+      result.sigma[0], result.sigma[1], result.sigma[2], result.sigma[3] * kDegPerRad,
+      result.sigma[4] * kDegPerRad, result.sigma[5] * kDegPerRad);
   fmt::print("wrote {}\n", options.out);
   if (!result.converged) {
     fmt::print(stderr, "taiga georef: warning: {} did not converge in {} iterations\n",

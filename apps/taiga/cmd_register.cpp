@@ -6,10 +6,10 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
-#include <numbers>
 #include <sstream>
 
 #include "command.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/registration/registration.hpp"
@@ -67,8 +67,8 @@ std::string formatResult(const RegisterOptions& o, const registration::Registrat
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const Eigen::Vector3d rpy_deg =
       Eigen::Vector3d(std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
-                      std::atan2(R(1, 0), R(0, 0))) *
-      180.0 / std::numbers::pi;
+                      r.T_target_source.rotation().yaw()) *
+      kDegPerRad;
   std::string out;
   if (o.json) {
     std::string rows;

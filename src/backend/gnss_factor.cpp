@@ -21,11 +21,10 @@ lie::SE3 enuWorldFromBlock(const double* enu_block) {
 }
 
 void writeEnuWorldBlock(const lie::SE3& T_enu_world, double* enu_block) {
-  const Eigen::Matrix3d R = T_enu_world.rotation().matrix();
   enu_block[0] = T_enu_world.translation().x();
   enu_block[1] = T_enu_world.translation().y();
   enu_block[2] = T_enu_world.translation().z();
-  enu_block[3] = std::atan2(R(1, 0), R(0, 0));  // heading of the world's x axis in ENU
+  enu_block[3] = T_enu_world.rotation().yaw();  // heading of the world's x axis in ENU
 }
 
 GnssFactor::GnssFactor(const Eigen::Vector3d& d_body, const Eigen::Vector3d& p_enu,

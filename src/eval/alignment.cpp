@@ -2,11 +2,10 @@
 
 #include <fmt/format.h>
 
-#include <Eigen/SVD>
 #include <cassert>
-#include <limits>
 
 #include "taiga/core/errors.hpp"
+#include "taiga/lie/umeyama.hpp"
 
 namespace taiga::eval {
 
@@ -36,42 +35,14 @@ AlignmentTransform umeyama(const std::vector<Eigen::Vector3d>& source,
   assert(source.size() == target.size());
   const std::size_t n = source.size();
   if (n == 0) throw InputError("cannot align: no associated poses");
-  Eigen::Vector3d mean_x = Eigen::Vector3d::Zero(), mean_y = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    mean_x += source[i];
-    mean_y += target[i];
-  }
-  const double count = static_cast<double>(n);
-  mean_x /= count;
-  mean_y /= count;
-  double sigma_x = 0.0;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d dx = source[i] - mean_x;
-    sigma_x += dx.squaredNorm();
-    covariance += (target[i] - mean_y) * dx.transpose();
-  }
-  sigma_x /= count;
-  covariance /= count;
-
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance,
-                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d d = svd.singularValues();
-  int rank = 0;
-  for (int i = 0; i < 3; ++i) rank += d[i] > std::numeric_limits<double>::epsilon() ? 1 : 0;
+  const int rank = lie::crossCovarianceRank(source, target);
   if (rank < 2)
     throw InputError(fmt::format(
         "cannot align ({} pose pairs): the positions lie on a line or a point (covariance rank "
         "{} < 2), so the rotation is not determined; use --align origin or --align none",
         n, rank));
-  const Eigen::Matrix3d& U = svd.matrixU();
-  const Eigen::Matrix3d& V = svd.matrixV();
-  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
-  if (U.determinant() * V.determinant() < 0.0) S(2, 2) = -1.0;
-  const Eigen::Matrix3d R = U * S * V.transpose();
-  const double scale = with_scale ? (d.asDiagonal() * S).trace() / sigma_x : 1.0;
-  const Eigen::Vector3d t = mean_y - scale * R * mean_x;
-  return {lie::SE3(lie::SO3::fromMatrix(R), t), scale};
+  const lie::Similarity similarity = lie::umeyama(source, target, with_scale);
+  return {similarity.T_target_source, similarity.scale};
 }
 
 AlignmentTransform computeAlignment(const std::vector<StampedPose>& est,

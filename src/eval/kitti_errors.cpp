@@ -1,7 +1,8 @@
 #include "taiga/eval/kitti_errors.hpp"
 
 #include <cassert>
-#include <numbers>
+
+#include "taiga/core/angles.hpp"
 
 namespace taiga::eval {
 
@@ -36,7 +37,7 @@ std::optional<KittiResult> computeKittiErrors(const std::vector<StampedPose>& es
   }
   const double n = static_cast<double>(result.segments.size());
   result.translation_error_percent = sum_t / n * 100.0;
-  result.rotation_error_deg_per_100m = sum_r / n * 180.0 / std::numbers::pi * 100.0;
+  result.rotation_error_deg_per_100m = sum_r / n * kDegPerRad * 100.0;
   return result;
 }
 

@@ -4,13 +4,13 @@
 
 #include <cassert>
 #include <cmath>
-#include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 
 namespace taiga::eval {
 
-double rotationAngleDeg(const lie::SO3& R) { return R.angle() * 180.0 / std::numbers::pi; }
+double rotationAngleDeg(const lie::SO3& R) { return R.angle() * kDegPerRad; }
 
 ApeResult computeApe(const std::vector<StampedPose>& est, const std::vector<StampedPose>& ref,
                      bool with_rotation) {

@@ -1,10 +1,10 @@
 // Text and Markdown renderings of an evaluation.
 #include <fmt/format.h>
 
-#include <numbers>
 #include <string>
 #include <vector>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/eval/report.hpp"
 
 namespace taiga::eval {
@@ -44,8 +44,8 @@ std::vector<StatsRow> statsRows(const EvalReport& report) {
 std::string transformText(const EvalResult& r) {
   const Eigen::Vector3d& t = r.transform.T_ref_est.translation();
   return fmt::format("rotation {:.6f} deg, translation [{:.6f}, {:.6f}, {:.6f}] m, scale {:.6f}",
-                     r.transform.T_ref_est.rotation().angle() * 180.0 / std::numbers::pi, t.x(),
-                     t.y(), t.z(), r.transform.scale);
+                     r.transform.T_ref_est.rotation().angle() * kDegPerRad, t.x(), t.y(), t.z(),
+                     r.transform.scale);
 }
 
 std::vector<ValueRow> valueRows(const EvalReport& report) {

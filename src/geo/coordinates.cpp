@@ -4,14 +4,12 @@
 #include <proj.h>
 
 #include <cmath>
-#include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 
 namespace taiga::geo {
 namespace {
-constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 std::string projError(PJ_CONTEXT* context) {
   return proj_context_errno_string(context, proj_context_errno(context));
@@ -122,7 +120,7 @@ Geodetic CoordinateConverter::fromEcef(const Eigen::Vector3d& p_ecef) const {
 }
 
 Eigen::Matrix3d CoordinateConverter::R_ecef_enu(const Geodetic& origin) {
-  const double lat = origin.latitude_deg * kDegToRad, lon = origin.longitude_deg * kDegToRad;
+  const double lat = origin.latitude_deg * kRadPerDeg, lon = origin.longitude_deg * kRadPerDeg;
   Eigen::Matrix3d R;
   R.col(0) << -std::sin(lon), std::cos(lon), 0.0;
   R.col(1) << -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat);
@@ -151,7 +149,7 @@ GridTangent CoordinateConverter::gridTangent(const Geodetic& origin) const {
   GridTangent tangent;
   tangent.scale = std::hypot(d_east.x(), d_east.y());
   const double yaw = std::atan2(d_east.y(), d_east.x());
-  tangent.yaw_deg = yaw * kRadToDeg;
+  tangent.yaw_deg = yaw * kDegPerRad;
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   T.topLeftCorner<2, 2>() << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
   T.topLeftCorner<2, 2>() *= tangent.scale;

@@ -53,9 +53,8 @@ void FitOptions::validate() const {
 Eigen::Vector3d rollPitchYaw(const lie::SO3& rotation) {
   const Eigen::Matrix3d R = rotation.matrix();
   // R = Rz(yaw) Ry(pitch) Rx(roll): R(2,0) = -sin(pitch), R(2,1)/R(2,2) = tan(roll),
-  // R(1,0)/R(0,0) = tan(yaw).
-  return {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
-          std::atan2(R(1, 0), R(0, 0))};
+  // R(1,0)/R(0,0) = tan(yaw) (SO3::yaw()).
+  return {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)), rotation.yaw()};
 }
 
 }  // namespace taiga::georef

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "taiga/core/errors.hpp"
-#include "taiga/eval/alignment.hpp"
+#include "taiga/lie/umeyama.hpp"
 
 namespace taiga::georef::detail {
 
@@ -93,7 +93,15 @@ lie::SE3 rigidFit(const std::vector<AssociatedFix>& pairs, const std::vector<boo
     p_world.push_back(pairs[i].p_world);
     p_enu.push_back(pairs[i].fix.p_enu);
   }
-  return eval::umeyama(p_world, p_enu, /*with_scale=*/false).T_ref_est;
+  // The callers have checked that the trajectory's positions span more than a line; the fixes'
+  // positions may still not (all at one spot).
+  const int rank = lie::crossCovarianceRank(p_world, p_enu);
+  if (rank < 2)
+    throw InputError(fmt::format(
+        "georef: the positions of the {} fixes do not determine a rotation (their covariance with "
+        "the trajectory's has rank {} < 2)",
+        p_world.size(), rank));
+  return lie::umeyama(p_world, p_enu, /*with_scale=*/false).T_target_source;
 }
 
 Matrix6d inverseNormal(const Matrix6d& H) {

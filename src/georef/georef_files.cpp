@@ -1,15 +1,19 @@
 // Reading the GNSS input of `taiga georef` and writing its outputs (formats in
-// docs/georeferencing.md). Numbers are written with fmt's shortest round-trip representation, so
-// grid coordinates keep full double precision.
+// docs/georeferencing.md). georef.yaml is emitted with yaml-cpp and trajectory.geojson with
+// nlohmann-json, which quote and escape the file and CRS names; numbers keep full double precision
+// (grid coordinates need it): in the YAML as fmt's shortest round-trip text, in the GeoJSON as
+// nlohmann-json's round-trip text.
 #include "taiga/georef/georef_files.hpp"
 
 #include <fmt/format.h>
 #include <fmt/os.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cctype>
 #include <cmath>
-#include <numbers>
+#include <nlohmann/json.hpp>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/io/recording.hpp"
 
@@ -21,21 +25,37 @@ std::string lowercase(std::string text) {
   return text;
 }
 
-std::string matrixRows(const Eigen::Matrix4d& M, const char* indent) {
-  std::string text;
-  for (int r = 0; r < 4; ++r)
-    text += fmt::format("{}- [{}, {}, {}, {}]\n", indent, M(r, 0), M(r, 1), M(r, 2), M(r, 3));
-  return text;
+/// A double for the YAML emitter: yaml-cpp would write 17 significant digits (0.1 as
+/// 0.10000000000000001), so finite values go out as fmt's shortest text that reads back as the
+/// same double, a plain scalar; non-finite ones as yaml-cpp's .nan, .inf and -.inf, which YAML
+/// readers (yaml-cpp's as<double> too) take for numbers.
+struct Exact {
+  double value;
+};
+
+YAML::Emitter& operator<<(YAML::Emitter& out, Exact number) {
+  if (std::isfinite(number.value)) return out << fmt::format("{}", number.value);
+  return out << number.value;
 }
 
-/// A JSON string literal (names of CRSs and files are plain, but quotes must not break it).
-std::string jsonString(const std::string& text) {
-  std::string quoted = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') quoted += '\\';
-    quoted += c;
-  }
-  return quoted + "\"";
+/// The rows of M as a block sequence of flow sequences ("- [a, b, c, d]"), one row per line.
+void emitMatrixRows(YAML::Emitter& out, const Eigen::Matrix4d& M) {
+  out << YAML::BeginSeq;
+  for (int r = 0; r < 4; ++r)
+    out << YAML::Flow << YAML::BeginSeq << Exact{M(r, 0)} << Exact{M(r, 1)} << Exact{M(r, 2)}
+        << Exact{M(r, 3)} << YAML::EndSeq;
+  out << YAML::EndSeq;
+}
+
+void emitVector(YAML::Emitter& out, const Eigen::Vector3d& v) {
+  out << YAML::Flow << YAML::BeginSeq << Exact{v.x()} << Exact{v.y()} << Exact{v.z()}
+      << YAML::EndSeq;
+}
+
+/// A comment on lines of its own before the next top-level key (yaml-cpp would otherwise append it
+/// to the line of the previous value). Lines of `text` are separated by '\n'.
+void emitCommentLines(YAML::Emitter& out, const std::string& text) {
+  out << YAML::Newline << YAML::Comment(text);
 }
 
 }  // namespace
@@ -70,60 +90,102 @@ void writeGeoJson(const std::filesystem::path& path, const std::vector<GridPose>
                   const std::string& name) {
   // GeoJSON (RFC 7946) drops the "crs" member and means WGS84 longitude/latitude, but QGIS and
   // GDAL still read the 2008 form's named CRS, which keeps the grid coordinates exact.
-  auto out = fmt::output_file(path.string());
-  out.print("{{\n  \"type\": \"FeatureCollection\",\n  \"name\": {},\n", jsonString(name));
-  out.print("  \"crs\": {{\"type\": \"name\", \"properties\": {{\"name\": "
-            "\"urn:ogc:def:crs:EPSG::{}\"}}}},\n",
-            epsg);
-  out.print("  \"features\": [{{\n    \"type\": \"Feature\",\n");
-  out.print("    \"properties\": {{\"name\": {}, \"t_start_s\": {}, \"t_end_s\": {}}},\n",
-            jsonString(name), poses.empty() ? 0.0 : poses.front().t_s,
-            poses.empty() ? 0.0 : poses.back().t_s);
-  out.print("    \"geometry\": {{\"type\": \"LineString\", \"coordinates\": [");
-  for (std::size_t i = 0; i < poses.size(); ++i)
-    out.print("{}\n      [{}, {}, {}]", i == 0 ? "" : ",", poses[i].easting_m, poses[i].northing_m,
-              poses[i].height_m);
-  out.print("\n    ]}}\n  }}]\n}}\n");
+  nlohmann::ordered_json coordinates = nlohmann::ordered_json::array();
+  for (const GridPose& pose : poses)
+    coordinates.push_back({pose.easting_m, pose.northing_m, pose.height_m});
+  nlohmann::ordered_json feature;
+  feature["type"] = "Feature";
+  feature["properties"] = {{"name", name},
+                           {"t_start_s", poses.empty() ? 0.0 : poses.front().t_s},
+                           {"t_end_s", poses.empty() ? 0.0 : poses.back().t_s}};
+  feature["geometry"] = {{"type", "LineString"}, {"coordinates", std::move(coordinates)}};
+  nlohmann::ordered_json geojson;
+  geojson["type"] = "FeatureCollection";
+  geojson["name"] = name;
+  geojson["crs"] = {{"type", "name"},
+                    {"properties", {{"name", fmt::format("urn:ogc:def:crs:EPSG::{}", epsg)}}}};
+  geojson["features"].push_back(std::move(feature));
+  // A file name that is not UTF-8 gets U+FFFD in the output instead of an exception.
+  fmt::output_file(path.string())
+      .print("{}\n", geojson.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace));
 }
 
 void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& report) {
-  constexpr double kDeg = 180.0 / std::numbers::pi;
   const GeorefFit& fit = report.fit;
-  const Eigen::Vector3d rpy_deg = rollPitchYaw(fit.T_enu_world.rotation()) * kDeg;
-  auto out = fmt::output_file(path.string());
-  out.print("# taiga georef: where the trajectory's world frame lies (docs/georeferencing.md)\n");
-  out.print("method: {}\ntrajectory: {}\ngnss: {}\n", report.method, jsonString(report.trajectory_file),
-            jsonString(report.gnss_file));
-  out.print("epsg: {}\ncrs_name: {}\n", report.epsg, jsonString(report.crs_name));
-  out.print("enu_origin:  # the local east-north-up frame of the fit\n");
-  out.print("  latitude_deg: {}\n  longitude_deg: {}\n  height_ellipsoid_m: {}\n",
-            report.origin.latitude_deg, report.origin.longitude_deg, report.origin.height_m);
-  out.print("  easting_m: {}\n  northing_m: {}\n", report.origin_grid.x(), report.origin_grid.y());
-  out.print("# p_enu = T_enu_world * p_world (rigid)\nT_enu_world:\n{}",
-            matrixRows(fit.T_enu_world.matrix(), "  "));
-  out.print("T_enu_world_translation_m: [{}, {}, {}]\n", fit.T_enu_world.translation().x(),
-            fit.T_enu_world.translation().y(), fit.T_enu_world.translation().z());
-  out.print("T_enu_world_roll_pitch_yaw_deg: [{}, {}, {}]\n", rpy_deg.x(), rpy_deg.y(), rpy_deg.z());
-  out.print("# [E, N, h, 1] = T_epsg_world * [x, y, z, 1]: tangent plane at the ENU origin (scale and\n"
-            "# meridian convergence there, heights unscaled); trajectory_epsg{}.csv is exact\n",
-            report.epsg);
-  out.print("T_epsg_world:\n{}", matrixRows(report.T_epsg_world, "  "));
-  out.print("yaw_grid_world_deg: {}\n",
-            std::atan2(report.T_epsg_world(1, 0), report.T_epsg_world(0, 0)) * kDeg);
-  out.print("# 1-sigma of T_enu_world: translation in ENU (m), small rotations about east (roll),\n"
-            "# north (pitch) and up (yaw) (deg); from the normal equations scaled by the residuals\n");
-  out.print("sigma:\n  east_m: {}\n  north_m: {}\n  up_m: {}\n", fit.sigma[0], fit.sigma[1], fit.sigma[2]);
-  out.print("  roll_deg: {}\n  pitch_deg: {}\n  yaw_deg: {}\n", fit.sigma[3] * kDeg,
-            fit.sigma[4] * kDeg, fit.sigma[5] * kDeg);
-  out.print("fixes:\n  total: {}\n  gated_no_fix: {}\n  gated_sigma: {}\n  gated_invalid: {}\n",
-            report.fixes_total, report.gated_no_fix, report.gated_sigma, report.gated_invalid);
-  out.print("  outside_trajectory: {}\n  in_trajectory_gap: {}\n  associated: {}\n",
-            report.outside_span, report.in_gap, report.associated);
-  out.print("  used: {}\n  outliers: {}\n  without_orientation: {}\n", fit.inliers, fit.outliers,
-            fit.without_orientation);
-  out.print("residual_rms_m:\n  total: {}\n  horizontal: {}\n  vertical: {}\n", fit.residual_rms_m,
-            fit.horizontal_rms_m, fit.vertical_rms_m);
-  out.print("iterations: {}\nconverged: {}\n", fit.iterations, fit.converged);
+  const Eigen::Vector3d rpy_deg = rollPitchYaw(fit.T_enu_world.rotation()) * kDegPerRad;
+  YAML::Emitter out;
+  out << YAML::Comment(
+      "taiga georef: where the trajectory's world frame lies (docs/georeferencing.md)");
+  out << YAML::BeginMap;
+  out << YAML::Key << "method" << YAML::Value << report.method;
+  out << YAML::Key << "trajectory" << YAML::Value << YAML::DoubleQuoted << report.trajectory_file;
+  out << YAML::Key << "gnss" << YAML::Value << YAML::DoubleQuoted << report.gnss_file;
+  out << YAML::Key << "epsg" << YAML::Value << report.epsg;
+  out << YAML::Key << "crs_name" << YAML::Value << YAML::DoubleQuoted << report.crs_name;
+  out << YAML::Key << "enu_origin" << YAML::Comment("the local east-north-up frame of the fit")
+      << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "latitude_deg" << YAML::Value << Exact{report.origin.latitude_deg};
+  out << YAML::Key << "longitude_deg" << YAML::Value << Exact{report.origin.longitude_deg};
+  out << YAML::Key << "height_ellipsoid_m" << YAML::Value << Exact{report.origin.height_m};
+  out << YAML::Key << "easting_m" << YAML::Value << Exact{report.origin_grid.x()};
+  out << YAML::Key << "northing_m" << YAML::Value << Exact{report.origin_grid.y()};
+  out << YAML::EndMap;
+
+  emitCommentLines(out, "p_enu = T_enu_world * p_world (rigid)");
+  out << YAML::Key << "T_enu_world" << YAML::Value;
+  emitMatrixRows(out, fit.T_enu_world.matrix());
+  out << YAML::Key << "T_enu_world_translation_m" << YAML::Value;
+  emitVector(out, fit.T_enu_world.translation());
+  out << YAML::Key << "T_enu_world_roll_pitch_yaw_deg" << YAML::Value;
+  emitVector(out, rpy_deg);
+
+  emitCommentLines(
+      out, fmt::format("[E, N, h, 1] = T_epsg_world * [x, y, z, 1]: tangent plane at the ENU "
+                       "origin (scale and\nmeridian convergence there, heights unscaled); "
+                       "trajectory_epsg{}.csv is exact",
+                       report.epsg));
+  out << YAML::Key << "T_epsg_world" << YAML::Value;
+  emitMatrixRows(out, report.T_epsg_world);
+  // The heading of the grid's x axis in the world, from the tangent-plane matrix (which carries
+  // the grid scale, so it is no rotation for lie::SO3::yaw()).
+  out << YAML::Key << "yaw_grid_world_deg" << YAML::Value
+      << Exact{std::atan2(report.T_epsg_world(1, 0), report.T_epsg_world(0, 0)) * kDegPerRad};
+
+  emitCommentLines(out,
+                   "1-sigma of T_enu_world: translation in ENU (m), small rotations about east "
+                   "(roll),\nnorth (pitch) and up (yaw) (deg); from the normal equations scaled by "
+                   "the residuals");
+  out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "east_m" << YAML::Value << Exact{fit.sigma[0]};
+  out << YAML::Key << "north_m" << YAML::Value << Exact{fit.sigma[1]};
+  out << YAML::Key << "up_m" << YAML::Value << Exact{fit.sigma[2]};
+  out << YAML::Key << "roll_deg" << YAML::Value << Exact{fit.sigma[3] * kDegPerRad};
+  out << YAML::Key << "pitch_deg" << YAML::Value << Exact{fit.sigma[4] * kDegPerRad};
+  out << YAML::Key << "yaw_deg" << YAML::Value << Exact{fit.sigma[5] * kDegPerRad};
+  out << YAML::EndMap;
+
+  out << YAML::Key << "fixes" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "total" << YAML::Value << report.fixes_total;
+  out << YAML::Key << "gated_no_fix" << YAML::Value << report.gated_no_fix;
+  out << YAML::Key << "gated_sigma" << YAML::Value << report.gated_sigma;
+  out << YAML::Key << "gated_invalid" << YAML::Value << report.gated_invalid;
+  out << YAML::Key << "outside_trajectory" << YAML::Value << report.outside_span;
+  out << YAML::Key << "in_trajectory_gap" << YAML::Value << report.in_gap;
+  out << YAML::Key << "associated" << YAML::Value << report.associated;
+  out << YAML::Key << "used" << YAML::Value << fit.inliers;
+  out << YAML::Key << "outliers" << YAML::Value << fit.outliers;
+  out << YAML::Key << "without_orientation" << YAML::Value << fit.without_orientation;
+  out << YAML::EndMap;
+
+  out << YAML::Key << "residual_rms_m" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "total" << YAML::Value << Exact{fit.residual_rms_m};
+  out << YAML::Key << "horizontal" << YAML::Value << Exact{fit.horizontal_rms_m};
+  out << YAML::Key << "vertical" << YAML::Value << Exact{fit.vertical_rms_m};
+  out << YAML::EndMap;
+  out << YAML::Key << "iterations" << YAML::Value << fit.iterations;
+  out << YAML::Key << "converged" << YAML::Value << fit.converged;
+  out << YAML::EndMap;
+  fmt::output_file(path.string()).print("{}\n", out.c_str());
 }
 
 }  // namespace taiga::georef

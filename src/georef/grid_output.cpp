@@ -1,11 +1,11 @@
 #include "taiga/georef/grid_output.hpp"
 
 #include <cmath>
-#include <numbers>
+
+#include "taiga/core/angles.hpp"
 
 namespace taiga::georef {
 namespace {
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 /// Wraps an angle in degrees into (-180, 180].
 double wrapDegrees(double angle_deg) {

@@ -3,14 +3,12 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 
 namespace taiga::imu {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 struct MeanAndStd {
   Vector3 mean = Vector3::Zero();
@@ -87,7 +85,7 @@ InitialState initializeFromImu(std::span<const ImuSample> samples,
   // Priors: position and heading fix the gauge of the world frame; tilt, velocity and biases are
   // as uncertain as the way they were found.
   const double tilt_sigma =
-      init.at_rest || init.from_orientation ? 0.5 / kRadToDeg : 3.0 / kRadToDeg;
+      init.at_rest || init.from_orientation ? 0.5 / kDegPerRad : 3.0 / kDegPerRad;
   const double velocity_sigma = init.at_rest ? 0.01 : 1.0;
   const double gyro_bias_sigma =
       init.at_rest ? gyro.std / std::sqrt(static_cast<double>(n)) + 1e-4 : 0.02;
@@ -98,8 +96,8 @@ InitialState initializeFromImu(std::span<const ImuSample> samples,
 
   const Matrix3 R = init.state.R_world_body.matrix();
   const Vector3 rpy_deg =
-      Vector3(std::atan2(R(2, 1), R(2, 2)), -std::asin(R(2, 0)), std::atan2(R(1, 0), R(0, 0))) *
-      kRadToDeg;
+      Vector3(std::atan2(R(2, 1), R(2, 2)), -std::asin(R(2, 0)), init.state.R_world_body.yaw()) *
+      kDegPerRad;
   init.description = fmt::format(
       "{}{}: roll {:.2f} deg, pitch {:.2f} deg, yaw {:.2f} deg from {} readings over {:.2f} s",
       init.at_rest ? "at rest" : "moving", init.from_orientation ? " (IMU orientation)" : "",

@@ -6,19 +6,18 @@
 
 #include <cmath>
 #include <fstream>
-#include <numbers>
 #include <optional>
 #include <sstream>
 #include <tuple>
 #include <vector>
 
 #include "numeric_text.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 
 namespace taiga::io {
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 // A quaternion typed by hand with a few decimals is normalized; one further from unit length is
 // more likely a mistake (wrong order, a missing component) and is rejected.
 constexpr double kQuaternionNormTolerance = 1e-2;
@@ -188,7 +187,7 @@ lie::SE3 parsePose(const Mapping& parent, std::string_view key, const YAML::Node
   }
   if (rpy) {
     const auto v = parseNumbers(m, "rpy_deg", *rpy, 3, "[roll, pitch, yaw] in degrees");
-    rotation = lie::SO3::fromRollPitchYaw(v[0] * kDegToRad, v[1] * kDegToRad, v[2] * kDegToRad);
+    rotation = lie::SO3::fromRollPitchYaw(v[0] * kRadPerDeg, v[1] * kRadPerDeg, v[2] * kRadPerDeg);
   }
   return lie::SE3(rotation, translation);
 }

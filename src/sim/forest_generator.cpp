@@ -5,13 +5,13 @@
 #include <unordered_map>
 
 #include "geometry_buffers.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim::detail {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 /// Branches below this height above the ground are kept away from the walked path, m.
 constexpr double kHeadZone_m = 4.0;
 
@@ -137,16 +137,16 @@ void addTree(GeometryBuffers& g, Rng& rng, const Tree& tree, double max_low_bran
   switch (tree.species) {
     case Species::kPine:
       spacing = 0.6, per_whorl = 4, lmax = rng.uniform(1.5, 2.5);
-      style = {15 * kDeg, 0.1, 3.0, 0.14, 0.4};
+      style = {15 * kRadPerDeg, 0.1, 3.0, 0.14, 0.4};
       break;
     case Species::kSpruce:
       spacing = 0.5, per_whorl = 4, lmax = rng.uniform(2.0, 3.0);
-      style = {-12 * kDeg, 0.15, 3.0, 0.13, 0.1};
+      style = {-12 * kRadPerDeg, 0.15, 3.0, 0.13, 0.1};
       break;
     case Species::kBirch:
     case Species::kSapling:
       spacing = 0.8, per_whorl = 3, lmax = rng.uniform(1.5, 3.0);
-      style = {40 * kDeg, 0.1, 4.0, 0.08, 0.3};
+      style = {40 * kRadPerDeg, 0.1, 4.0, 0.08, 0.3};
       break;
   }
   const double phase = rng.uniform(0.0, 2.0 * kPi);
@@ -170,7 +170,7 @@ void addTree(GeometryBuffers& g, Rng& rng, const Tree& tree, double max_low_bran
   // Dead twigs below the live crown of spruces (and a few on pines): what lidar sees so much of
   // in managed boreal stands.
   const double twig_spacing = tree.species == Species::kSpruce ? 0.4 : 1.2;
-  const BranchStyle twig{-5 * kDeg, 0.05, 0.0, 0.0, 1.0, Material::kDeadWood};
+  const BranchStyle twig{-5 * kRadPerDeg, 0.05, 0.0, 0.0, 1.0, Material::kDeadWood};
   for (double s = 1.0; s < hc; s += twig_spacing * rng.uniform(0.7, 1.3)) {
     if (tree.species == Species::kBirch) break;
     const int n = rng.uniform(0.0, 1.0) < 0.5 ? 2 : 3;
@@ -191,7 +191,7 @@ void addSapling(GeometryBuffers& g, Rng& rng, const Vector3d& base, double heigh
       {Vector4d(base.x(), base.y(), base.z() - 0.1, r0),
        Vector4d(mid.x(), mid.y(), mid.z(), 0.6 * r0), Vector4d(tip.x(), tip.y(), tip.z(), 0.003)},
       Material::kBranch);
-  const BranchStyle style{10 * kDeg, 0.1, 6.0, 0.07, 0.2};
+  const BranchStyle style{10 * kRadPerDeg, 0.1, 6.0, 0.07, 0.2};
   for (double s = 0.3 * height_m; s < height_m - 0.1; s += rng.uniform(0.25, 0.45)) {
     const double f = s / height_m;
     const double length = (1.0 - f) * std::min(1.0, 0.35 * height_m) + 0.1;
@@ -332,7 +332,7 @@ ForestContents buildForest(const ForestParams& params, std::uint64_t seed,
     tree.dbh_m = dbh;
     tree.height_m = std::clamp(
         10.0 + 18.0 * std::pow((dbh - 0.08) / 0.42, 0.6) + rng.normal(0.0, 1.5), 10.0, 28.0);
-    tree.lean_rad = std::min(std::abs(rng.normal(0.0, 2.5 * kDeg)), 8.0 * kDeg);
+    tree.lean_rad = std::min(std::abs(rng.normal(0.0, 2.5 * kRadPerDeg)), 8.0 * kRadPerDeg);
     tree.lean_azimuth_rad = rng.uniform(0.0, 2.0 * kPi);
     const double crown_fraction = tree.species == Species::kPine     ? rng.uniform(0.5, 0.7)
                                   : tree.species == Species::kSpruce ? rng.uniform(0.1, 0.3)

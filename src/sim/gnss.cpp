@@ -3,18 +3,18 @@
 #include <cmath>
 #include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim {
 namespace {
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 constexpr double kA = 6378137.0;            // WGS84 semi-major axis, m
 constexpr double kF = 1.0 / 298.257223563;  // WGS84 flattening
 constexpr double kE2 = kF * (2.0 - kF);     // first eccentricity squared
 
 Eigen::Vector3d toEcef(const Geodetic& g) {
-  const double lat = g.latitude_deg * kDeg, lon = g.longitude_deg * kDeg;
+  const double lat = g.latitude_deg * kRadPerDeg, lon = g.longitude_deg * kRadPerDeg;
   const double n = kA / std::sqrt(1.0 - kE2 * std::sin(lat) * std::sin(lat));
   return {(n + g.height_m) * std::cos(lat) * std::cos(lon),
           (n + g.height_m) * std::cos(lat) * std::sin(lon),
@@ -31,12 +31,12 @@ Geodetic fromEcef(const Eigen::Vector3d& x) {
     h = p / std::cos(lat) - n;
     lat = std::atan2(x.z(), p * (1.0 - kE2 * n / (n + h)));
   }
-  return {lat / kDeg, lon / kDeg, h};
+  return {lat / kRadPerDeg, lon / kRadPerDeg, h};
 }
 
 /// Columns: east, north, up unit vectors in ECEF.
 Eigen::Matrix3d ecefFromEnu(const Geodetic& origin) {
-  const double lat = origin.latitude_deg * kDeg, lon = origin.longitude_deg * kDeg;
+  const double lat = origin.latitude_deg * kRadPerDeg, lon = origin.longitude_deg * kRadPerDeg;
   Eigen::Matrix3d R;
   R.col(0) << -std::sin(lon), std::cos(lon), 0.0;
   R.col(1) << -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat);
@@ -62,7 +62,7 @@ GnssSimulator::GnssSimulator(GnssParams params, std::uint64_t seed)
 double GnssSimulator::canopyCover(const Scene& scene, const Eigen::Vector3d& p_world) {
   int blocked = 0, total = 0;
   for (int ring = 0; ring < 3; ++ring) {
-    const double elevation = (25.0 + 25.0 * ring) * kDeg;
+    const double elevation = (25.0 + 25.0 * ring) * kRadPerDeg;
     const int n = 10 - 3 * ring;  // 10, 7, 4 (+ zenith below)
     for (int i = 0; i < n; ++i) {
       const double az = 2.0 * kPi * (i + 0.5 * ring) / n;
@@ -109,7 +109,7 @@ std::optional<GnssFix> GnssSimulator::next(const WalkingMotion& motion, const Sc
   }
   Eigen::Vector3d p_enu = p_world;
   if (params_.world_yaw_deg != 0.0) {  // world x is world_yaw_deg counterclockwise from east
-    const double yaw = params_.world_yaw_deg * kDeg;
+    const double yaw = params_.world_yaw_deg * kRadPerDeg;
     p_enu.x() = std::cos(yaw) * p_world.x() - std::sin(yaw) * p_world.y();
     p_enu.y() = std::sin(yaw) * p_world.x() + std::cos(yaw) * p_world.y();
   }

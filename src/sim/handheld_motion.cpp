@@ -19,12 +19,12 @@
 #include <stdexcept>
 
 #include "motion_models.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim::detail {
 namespace {
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 /// Harmonics of the arc-length correction g(v).
 constexpr int kArcHarmonics = 64;
 
@@ -250,8 +250,8 @@ double HandheldMotion::baseYawRate(double t) const {
   Eigen::Vector2d dc, ddc;
   curve(u.v, nullptr, &dc, &ddc);
   const double heading_rate = (dc.x() * ddc.y() - dc.y() * ddc.x()) / dc.squaredNorm() * u.d;
-  return heading_rate + sineJet(params_.look_around_deg * kDeg, 0.11, phases_[3], t).d +
-         sineJet(params_.look_around_fast_deg * kDeg, 0.43, phases_[4], t).d;
+  return heading_rate + sineJet(params_.look_around_deg * kRadPerDeg, 0.11, phases_[3], t).d +
+         sineJet(params_.look_around_fast_deg * kRadPerDeg, 0.43, phases_[4], t).d;
 }
 
 void HandheldMotion::drawFastTurns(double duration_s, std::uint64_t seed) {
@@ -263,10 +263,10 @@ void HandheldMotion::drawFastTurns(double duration_s, std::uint64_t seed) {
       Plateau p;
       p.t0_s = t + params_.fast_turn_interval_s * rng.uniform(0.5, 1.5);
       if (p.t0_s > duration_s + 60.0) break;
-      p.weight = rng.uniform(params_.fast_turn_min_deg, params_.fast_turn_max_deg) * kDeg *
+      p.weight = rng.uniform(params_.fast_turn_min_deg, params_.fast_turn_max_deg) * kRadPerDeg *
                  (rng.bernoulli(0.5) ? 1.0 : -1.0);
       p.hold_s = rng.uniform(0.3, 2.0);
-      const double target = rng.uniform(0.75, 1.0) * params_.fast_turn_rate_deg_s * kDeg;
+      const double target = rng.uniform(0.75, 1.0) * params_.fast_turn_rate_deg_s * kRadPerDeg;
       // The peak of |base rate + turn rate| falls as the ramp lengthens: bisect the ramp time.
       auto peakRate = [&](double ramp_s) {
         Plateau q = p;
@@ -314,11 +314,12 @@ MotionState HandheldMotion::at(double t) const {
   const double heading = std::atan2(dc.y(), dc.x());
   const double heading_rate = (dc.x() * ddc.y() - dc.y() * ddc.x()) / dc.squaredNorm() * u.d;
   const Jet yaw = Jet{heading, heading_rate, 0.0} +
-                  sineJet(p.look_around_deg * kDeg, 0.11, phases_[3], t) +
-                  sineJet(p.look_around_fast_deg * kDeg, 0.43, phases_[4], t) + turns_.value(t);
-  const Jet roll = tilt_gain * sineJet(p.roll_sway_deg * kDeg, 0.5 * f_step, phases_[5], t);
-  const Jet pitch = constant(p.pitch_mean_deg * kDeg) +
-                    tilt_gain * sineJet(p.pitch_sway_deg * kDeg, f_step, phases_[0] + 1.0, t);
+                  sineJet(p.look_around_deg * kRadPerDeg, 0.11, phases_[3], t) +
+                  sineJet(p.look_around_fast_deg * kRadPerDeg, 0.43, phases_[4], t) +
+                  turns_.value(t);
+  const Jet roll = tilt_gain * sineJet(p.roll_sway_deg * kRadPerDeg, 0.5 * f_step, phases_[5], t);
+  const Jet pitch = constant(p.pitch_mean_deg * kRadPerDeg) +
+                    tilt_gain * sineJet(p.pitch_sway_deg * kRadPerDeg, f_step, phases_[0] + 1.0, t);
 
   MotionState state;
   state.t_s = t;

@@ -5,13 +5,13 @@
 #include <numbers>
 
 #include "smooth.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/sim/machine.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim {
 namespace {
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 
 // Crane geometry, body frame (m): the pillar stands on the front frame ahead of the cabin.
 const Eigen::Vector3d kPillarBase_body(1.8, 0.0, -2.2);
@@ -21,7 +21,7 @@ constexpr double kStickLength_m = 3.8;
 constexpr double kHeadDrop_m = 0.6;  ///< head centre below the stick tip
 
 /// Folded for driving: boom up, stick down in front, head above the front frame.
-constexpr BoomPose kRestPose{0.0, 35.0 * kDeg, -80.0 * kDeg, 0.0, 0.0};
+constexpr BoomPose kRestPose{0.0, 35.0 * kRadPerDeg, -80.0 * kRadPerDeg, 0.0, 0.0};
 
 Eigen::Quaterniond rotZ(double a) { return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ())); }
 Eigen::Quaterniond rotY(double a) { return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY())); }
@@ -97,9 +97,9 @@ HarvesterMachine::HarvesterMachine(const std::vector<StandStill>& stand_stills,
     w.t0_s = s.start_s + 1.0;
     w.hold_s = std::max(0.0, s.end_s - s.start_s - 2.0 - 2.0 * w.ramp_s);
     const double side = rng.bernoulli(0.5) ? 1.0 : -1.0;
-    w.target = BoomPose{side * rng.uniform(60.0, 110.0) * kDeg, rng.uniform(5.0, 25.0) * kDeg,
-                        rng.uniform(-65.0, -40.0) * kDeg, rng.uniform(0.5, 1.8),
-                        rng.uniform(-90.0, 90.0) * kDeg};
+    w.target = BoomPose{side * rng.uniform(60.0, 110.0) * kRadPerDeg,
+                        rng.uniform(5.0, 25.0) * kRadPerDeg, rng.uniform(-65.0, -40.0) * kRadPerDeg,
+                        rng.uniform(0.5, 1.8), rng.uniform(-90.0, 90.0) * kRadPerDeg};
     for (double& p : w.phases) p = rng.uniform(0.0, 2.0 * kPi);
     work_.push_back(w);
   }
@@ -120,14 +120,14 @@ BoomPose HarvesterMachine::boomPose(double t) const {
     if (e == 0.0) continue;
     // Towards the working pose, with slow motions of the operator on top (felling, feeding).
     pose.slew_rad += e * (w.target.slew_rad - kRestPose.slew_rad +
-                          10.0 * kDeg * std::sin(2.0 * kPi * 0.05 * t + w.phases[0]));
+                          10.0 * kRadPerDeg * std::sin(2.0 * kPi * 0.05 * t + w.phases[0]));
     pose.lift_rad += e * (w.target.lift_rad - kRestPose.lift_rad +
-                          6.0 * kDeg * std::sin(2.0 * kPi * 0.08 * t + w.phases[1]));
+                          6.0 * kRadPerDeg * std::sin(2.0 * kPi * 0.08 * t + w.phases[1]));
     pose.stick_rad += e * (w.target.stick_rad - kRestPose.stick_rad +
-                           10.0 * kDeg * std::sin(2.0 * kPi * 0.11 * t + w.phases[2]));
+                           10.0 * kRadPerDeg * std::sin(2.0 * kPi * 0.11 * t + w.phases[2]));
     pose.telescope_m += e * (w.target.telescope_m - kRestPose.telescope_m);
     pose.head_turn_rad += e * (w.target.head_turn_rad +
-                               30.0 * kDeg * std::sin(2.0 * kPi * 0.07 * t + w.phases[3]));
+                               30.0 * kRadPerDeg * std::sin(2.0 * kPi * 0.07 * t + w.phases[3]));
   }
   return pose;
 }

@@ -14,13 +14,13 @@
 #include <numbers>
 
 #include "motion_models.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/sim/machine.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim::detail {
 namespace {
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 constexpr double kHalfWheelbase_m = 2.2;
 constexpr double kHalfTrack_m = 1.15;
 constexpr double kStartStill_s = 3.0;  ///< standing with the engine running before the first drive
@@ -131,8 +131,8 @@ void HarvesterMotion::drawVibration(std::uint64_t seed) {
         const double peak = p.harvester_vibration_mps2 * (axis == 2 ? 1.5 : 1.0);
         s.amplitude = peak / kVibrationSines / (w * w) * rng.uniform(0.7, 1.0);
       } else {
-        s.amplitude =
-            p.harvester_vibration_rate_deg_s * kDeg / kVibrationSines / w * rng.uniform(0.7, 1.0);
+        s.amplitude = p.harvester_vibration_rate_deg_s * kRadPerDeg / kVibrationSines / w *
+                      rng.uniform(0.7, 1.0);
       }
     }
   }

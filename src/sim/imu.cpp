@@ -2,14 +2,13 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/lie/so3.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim {
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 Eigen::Vector3d normal3(std::uint64_t seed, std::uint64_t k, std::uint64_t stream) {
   return {hashNormal(seed, k, stream, 0), hashNormal(seed, k, stream, 1),
@@ -23,12 +22,13 @@ ImuSimulator::ImuSimulator(ImuParams params, std::uint64_t seed, double world_ya
     biases_.accel_mps2 = params_.accel_turn_on_bias * normal3(seed_, 0, 10);
     biases_.gyro_radps = params_.gyro_turn_on_bias * normal3(seed_, 0, 11);
   }
-  R_enu_world_ = Eigen::AngleAxisd(world_yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  R_enu_world_ =
+      Eigen::AngleAxisd(world_yaw_deg * kRadPerDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   if (params_.orientation_output && params_.noise) {
     // Streams 20-22: the orientation's draws leave the accelerometer and gyro noise unchanged.
     const Eigen::Vector3d n = normal3(seed_, 0, 20);
-    tilt_error_rad_ = params_.orientation_tilt_error_deg * kDeg * n.head<2>();
-    heading_error_rad_ = params_.orientation_heading_offset_deg * kDeg;
+    tilt_error_rad_ = params_.orientation_tilt_error_deg * kRadPerDeg * n.head<2>();
+    heading_error_rad_ = params_.orientation_heading_offset_deg * kRadPerDeg;
   }
 }
 
@@ -37,10 +37,10 @@ void ImuSimulator::advanceOrientationError() {
   const double phi = std::exp(-dt / params_.orientation_tilt_correlation_s);
   const Eigen::Vector3d n = normal3(seed_, k_, 21);
   tilt_error_rad_ = phi * tilt_error_rad_ + std::sqrt(1.0 - phi * phi) *
-                                                params_.orientation_tilt_error_deg * kDeg *
+                                                params_.orientation_tilt_error_deg * kRadPerDeg *
                                                 n.head<2>();
   heading_error_rad_ +=
-      params_.orientation_heading_walk_deg_per_sqrt_s * kDeg * std::sqrt(dt) * n.z();
+      params_.orientation_heading_walk_deg_per_sqrt_s * kRadPerDeg * std::sqrt(dt) * n.z();
 }
 
 ImuSample ImuSimulator::next(const WalkingMotion& motion, double time_offset_s) {

@@ -12,6 +12,7 @@
 #include <limits>
 #include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/io/ouster/sensor_info.hpp"
@@ -22,7 +23,6 @@
 namespace taiga::sim {
 namespace {
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 constexpr int kMaxSubRays = 8;
 /// Range of a ray that hit nothing.
 constexpr double kNoHit = std::numeric_limits<double>::infinity();
@@ -117,8 +117,8 @@ LidarSimulator::LidarSimulator(LidarParams params, LidarGeometry geometry, std::
   for (int col = 0; col < cols; ++col) {
     const double theta_e = 2.0 * kPi * (1.0 - static_cast<double>(col) / cols);
     for (int row = 0; row < rows; ++row) {
-      const double az = theta_e - geometry_.beam_azimuth_deg[row] * kDeg;
-      const double alt = geometry_.beam_altitude_deg[row] * kDeg;
+      const double az = theta_e - geometry_.beam_azimuth_deg[row] * kRadPerDeg;
+      const double alt = geometry_.beam_altitude_deg[row] * kRadPerDeg;
       directions_lidar_[static_cast<std::size_t>(col) * rows + row] = Eigen::Vector3d(
           std::cos(az) * std::cos(alt), std::sin(az) * std::cos(alt), std::sin(alt));
     }
@@ -136,7 +136,7 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   // Sub-ray pattern: the centre and a ring at 3/4 of the half divergence, weights of a Gaussian
   // footprint.
   const int k_rays = params_.sub_rays;
-  const double ring_rad = 0.75 * 0.5 * params_.beam_divergence_deg * kDeg;
+  const double ring_rad = 0.75 * 0.5 * params_.beam_divergence_deg * kRadPerDeg;
   const double center_weight = k_rays == 1 ? 1.0 : 0.4;
   const double ring_weight = k_rays == 1 ? 0.0 : 0.6 / (k_rays - 1);
 

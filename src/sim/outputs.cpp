@@ -5,18 +5,15 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <numbers>
 #include <stdexcept>
 
 #include "machine_boxes_output.hpp"
 #include "truth_outputs.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
 
 namespace taiga::sim::detail {
-namespace {
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-}  // namespace
 
 void writeRigYaml(const std::filesystem::path& path, const Simulation& simulation) {
   SystemConfig config;
@@ -131,8 +128,8 @@ void writeSceneJson(const std::filesystem::path& path, const Simulation& simulat
                      {"z_m", t.base_world.z()},
                      {"dbh_m", t.dbh_m},
                      {"height_m", t.height_m},
-                     {"lean_deg", t.lean_rad * kRadToDeg},
-                     {"lean_azimuth_deg", t.lean_azimuth_rad * kRadToDeg},
+                     {"lean_deg", t.lean_rad * kDegPerRad},
+                     {"lean_azimuth_deg", t.lean_azimuth_rad * kDegPerRad},
                      {"crown_base_m", t.crown_base_m},
                      {"species", speciesName(t.species)}});
   }

@@ -10,6 +10,7 @@
 #include <optional>
 #include <tuple>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/io/las_writer.hpp"
 #include "taiga/sim/simulator.hpp"
@@ -17,7 +18,6 @@
 namespace taiga::sim {
 namespace {
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 /// Rows of one station cast and thinned together (bounds the memory of the raw samples).
 constexpr int kRowsPerChunk = 64;
 
@@ -63,8 +63,9 @@ std::vector<std::pair<double, int>> rowsOf(const ReferenceCloudParams& params) {
   const double step = params.angular_step_deg;
   for (double el = params.min_elevation_deg; el < 90.0; el += step) {
     // A uniform angular density: step / cos(elevation) in azimuth.
-    const int n_az = std::max(1, static_cast<int>(std::lround(360.0 * std::cos(el * kDeg) / step)));
-    rows.emplace_back(el * kDeg, n_az);
+    const int n_az =
+        std::max(1, static_cast<int>(std::lround(360.0 * std::cos(el * kRadPerDeg) / step)));
+    rows.emplace_back(el * kRadPerDeg, n_az);
   }
   return rows;
 }

@@ -4,17 +4,14 @@
 
 #include <cmath>
 #include <fstream>
-#include <numbers>
 #include <stdexcept>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/geo/coordinates.hpp"
 #include "taiga/sim/georef_truth.hpp"
 #include "taiga/sim/scenario_yaml.hpp"
 
 namespace taiga::sim {
-namespace {
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-}  // namespace
 
 void detail::writeText(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path);
@@ -40,7 +37,7 @@ GeorefTruth georefTruth(const GnssParams& gnss) {
   truth.yaw_grid_world_deg = tangent.yaw_deg + gnss.world_yaw_deg;
   truth.scale = tangent.scale;
   Eigen::Matrix4d T_enu_world = Eigen::Matrix4d::Identity();
-  const double yaw = gnss.world_yaw_deg / kRadToDeg;
+  const double yaw = gnss.world_yaw_deg / kDegPerRad;
   T_enu_world.topLeftCorner<2, 2>() << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
   truth.T_epsg_world = tangent.T_grid_enu * T_enu_world;
   return truth;
@@ -68,8 +65,8 @@ void writeTreesCsv(const std::filesystem::path& path, const Scene& scene) {
   std::size_t id = 0;
   for (const Tree& t : scene.trees()) {
     text += fmt::format("{},{},{},{},{},{},{},{},{}\n", id++, t.base_world.x(), t.base_world.y(),
-                        t.base_world.z(), t.dbh_m, t.height_m, t.lean_rad * kRadToDeg,
-                        t.lean_azimuth_rad * kRadToDeg, speciesName(t.species));
+                        t.base_world.z(), t.dbh_m, t.height_m, t.lean_rad * kDegPerRad,
+                        t.lean_azimuth_rad * kDegPerRad, speciesName(t.species));
   }
   writeText(path, text);
 }

@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <random>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/sim/simulator.hpp"
 
@@ -52,8 +52,8 @@ SimulatedMap simulateMap(const sim::Simulation& simulation, double range_sigma_m
     // Directions on a grid of azimuth x elevation, as a spinning lidar sees the forest.
     for (int a = 0; a < 180; ++a) {
       for (int e = 0; e < 16; ++e) {
-        const double azimuth = 2.0 * std::numbers::pi * a / 180.0;
-        const double elevation = (-45.0 + 4.0 * e) * std::numbers::pi / 180.0;
+        const double azimuth = 2.0 * a * kRadPerDeg;
+        const double elevation = (-45.0 + 4.0 * e) * kRadPerDeg;
         const Eigen::Vector3d d(std::cos(elevation) * std::cos(azimuth),
                                 std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
         const Eigen::Vector3d origin = T_world_body.translation();
@@ -104,8 +104,8 @@ TEST(MapSharpness, TruePosesScoreTheRangeNoiseAndPerturbedPosesScoreClearlyWorse
   // Every other keyframe 4 cm and 0.5 deg off.
   std::vector<lie::SE3> perturbed = map.T_ref_body;
   for (std::size_t k = 1; k < perturbed.size(); k += 2) {
-    const lie::SE3 error(Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * std::numbers::pi / 180.0,
-                                                              Eigen::Vector3d(1, 1, 1).normalized())),
+    const lie::SE3 error(Eigen::Quaterniond(Eigen::AngleAxisd(
+                             0.5 * kRadPerDeg, Eigen::Vector3d(1, 1, 1).normalized())),
                          Eigen::Vector3d(0.03, -0.02, 0.02));
     perturbed[k] = perturbed[k] * error;
   }

@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 
 #include "../support/temp_dir.hpp"
 #include "eval_test_support.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/eval/drift.hpp"
 #include "taiga/eval/evaluate.hpp"
@@ -19,7 +19,6 @@ namespace {
 
 using ::testing::ElementsAre;
 using ::testing::Pair;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 TEST(Statistics, MatchNumpyDefinitions) {
   const std::vector<double> v{4.0, 1.0, 3.0, 2.0};
@@ -63,7 +62,7 @@ TEST(Ape, RotationPartIsTheAngleOfTheRelativeRotationInDegrees) {
   const std::vector<StampedPose> ref = test::curvedPath(50);
   std::vector<StampedPose> est;
   for (std::size_t i = 0; i < ref.size(); ++i) {  // odd poses turned 10 deg, even ones 4 deg
-    const double angle = (i % 2 == 1 ? 10.0 : 4.0) * kDeg;
+    const double angle = (i % 2 == 1 ? 10.0 : 4.0) * kRadPerDeg;
     est.push_back({ref[i].t_s, ref[i].pose * lie::SE3(lie::SO3::fromAxisAngle({1, 1, 0}, angle),
                                                       Eigen::Vector3d::Zero())});
   }
@@ -104,8 +103,8 @@ TEST(Rpe, DeltaInMetresFollowsEvosPathFilterOnTheEstimate) {
 TEST(Rpe, ConstantYawErrorPerStep) {
   std::vector<StampedPose> ref = test::straightLine(6, 1.0), est;
   for (std::size_t i = 0; i < ref.size(); ++i)  // the estimate turns 2 deg more per step
-    est.push_back({ref[i].t_s,
-                   test::yawPose(2.0 * kDeg * static_cast<double>(i), ref[i].pose.translation())});
+    est.push_back({ref[i].t_s, test::yawPose(2.0 * kRadPerDeg * static_cast<double>(i),
+                                             ref[i].pose.translation())});
   const RpeResult r = computeRpe(est, ref, {1.0, DeltaUnit::kFrames});
   EXPECT_NEAR(r.rotation_deg.min, 2.0, 1e-9);
   EXPECT_NEAR(r.rotation_deg.max, 2.0, 1e-9);
@@ -152,8 +151,8 @@ TEST(Kitti, ConstantYawRateGivesItsRotationalError) {
         {ref[i].t_s, test::yawPose(0.001 * static_cast<double>(i), ref[i].pose.translation())});
   const std::optional<KittiResult> k = computeKittiErrors(est, ref);
   ASSERT_TRUE(k);
-  EXPECT_NEAR(k->rotation_error_deg_per_100m,
-              meanOverKittiSegments(0.001) * 180.0 / std::numbers::pi * 100.0, 1e-9);
+  EXPECT_NEAR(k->rotation_error_deg_per_100m, meanOverKittiSegments(0.001) * kDegPerRad * 100.0,
+              1e-9);
 }
 
 TEST(Kitti, NoSegmentsOnAPathShorterThan100Metres) {

@@ -7,12 +7,12 @@
 #include <numbers>
 #include <string>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/geo/coordinates.hpp"
 
 namespace taiga::geo {
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kA = 6378137.0;
 constexpr double kInvFlatteningGrs80 = 298.257222101;  // ETRS89
 constexpr double kInvFlatteningWgs84 = 298.257223563;
@@ -22,7 +22,7 @@ constexpr double kInvFlatteningWgs84 = 298.257223563;
 double meridianArc_m(double lat_deg, double inverse_flattening) {
   const double f = 1.0 / inverse_flattening, e2 = f * (2.0 - f);
   const int n = 20000;
-  const double h = lat_deg * kDeg / n;
+  const double h = lat_deg * kRadPerDeg / n;
   double sum = 0.0;
   for (int i = 0; i <= n; ++i) {
     const double s = std::sin(i * h);
@@ -93,7 +93,7 @@ TEST(CoordinateConverter, EcefMatchesTheClosedFormAndRoundTrips) {
   const double f = 1.0 / kInvFlatteningWgs84, e2 = f * (2.0 - f);
   for (const Geodetic& p : {Geodetic{61.0, 24.5, 120.0}, Geodetic{-45.0, -170.0, 5000.0},
                             Geodetic{0.0, 0.0, 0.0}}) {
-    const double lat = p.latitude_deg * kDeg, lon = p.longitude_deg * kDeg;
+    const double lat = p.latitude_deg * kRadPerDeg, lon = p.longitude_deg * kRadPerDeg;
     const double n = kA / std::sqrt(1.0 - e2 * std::sin(lat) * std::sin(lat));
     const Eigen::Vector3d expected((n + p.height_m) * std::cos(lat) * std::cos(lon),
                                    (n + p.height_m) * std::cos(lat) * std::sin(lon),
@@ -113,10 +113,10 @@ TEST(CoordinateConverter, LocalEnu) {
   const Eigen::Vector3d up = converter.toEnu(origin, {61.0, 24.5, 130.0});
   EXPECT_LT((up - Eigen::Vector3d(0, 0, 10)).norm(), 1e-6);
   // 1e-4 deg north: the meridian radius of curvature times the angle (to ~1e-8 relative).
-  const double f = 1.0 / kInvFlatteningWgs84, e2 = f * (2.0 - f), s = std::sin(61.0 * kDeg);
+  const double f = 1.0 / kInvFlatteningWgs84, e2 = f * (2.0 - f), s = std::sin(61.0 * kRadPerDeg);
   const double meridian_radius = kA * (1.0 - e2) / std::pow(1.0 - e2 * s * s, 1.5) + 120.0;
   const Eigen::Vector3d north = converter.toEnu(origin, {61.0001, 24.5, 120.0});
-  EXPECT_NEAR(north.y(), meridian_radius * 1e-4 * kDeg, 1e-5);
+  EXPECT_NEAR(north.y(), meridian_radius * 1e-4 * kRadPerDeg, 1e-5);
   EXPECT_NEAR(north.x(), 0.0, 1e-9);
   const Eigen::Vector3d p_enu(-123.4, 56.7, 8.9);
   EXPECT_LT((converter.toEnu(origin, converter.fromEnu(origin, p_enu)) - p_enu).norm(), 1e-8);
@@ -132,9 +132,10 @@ TEST(CoordinateConverter, GridTangentAtTheSimulatorsOrigin) {
   //   scale       = k0 (1 + l^2 (1 + eta^2) / 2 + l^4 (5 - 4 t^2 + 42 eta^2 + 13 eta^4 - 28 e'^2) / 24)
   // with t = tan(lat) (Snyder eq. 8-11)
   const double f = 1.0 / kInvFlatteningGrs80, e2 = f * (2.0 - f), ep2 = e2 / (1.0 - e2);
-  const double lat = 61.0 * kDeg, dlon = (24.5 - 27.0) * kDeg;
+  const double lat = 61.0 * kRadPerDeg, dlon = (24.5 - 27.0) * kRadPerDeg;
   const double l2 = std::pow(dlon * std::cos(lat), 2), eta2 = ep2 * std::pow(std::cos(lat), 2);
-  const double convergence_deg = dlon * std::sin(lat) * (1.0 + l2 * (1.0 + 3.0 * eta2) / 3.0) / kDeg;
+  const double convergence_deg =
+      dlon * std::sin(lat) * (1.0 + l2 * (1.0 + 3.0 * eta2) / 3.0) * kDegPerRad;
   EXPECT_NEAR(tangent.yaw_deg, convergence_deg, 2e-6);  // first order alone is 3e-4 deg off
   EXPECT_LT(tangent.yaw_deg, -2.0);                      // west of 27 E: grid north east of true
   // Grid metres per local metre at the origin's height: the point scale times R / (R + h), with

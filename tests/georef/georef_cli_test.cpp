@@ -18,6 +18,7 @@
 
 #include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/geo/coordinates.hpp"
 #include "taiga/io/las_reader.hpp"
 #include "taiga/io/trajectory_io.hpp"
@@ -27,7 +28,6 @@ namespace {
 
 using ::testing::HasSubstr;
 using test::runTaiga;
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 std::string readText(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -77,9 +77,8 @@ GeorefErrors scoreAgainstTruth(const std::filesystem::path& sim_dir,
         errors.max_horizontal_m, std::hypot(values[1] - truth_grid.x(), values[2] - truth_grid.y()));
     errors.mean_height_m += values[3] - truth_grid.z();
     errors.max_height_m = std::max(errors.max_height_m, std::abs(values[3] - truth_grid.z()));
-    const Eigen::Vector3d x_world = pose.pose.rotation().matrix().col(0);
     const double truth_yaw_deg =
-        std::atan2(x_world.y(), x_world.x()) * kDeg + truth["yaw_grid_world_deg"].as<double>();
+        pose.pose.rotation().yaw() * kDegPerRad + truth["yaw_grid_world_deg"].as<double>();
     errors.max_yaw_column_deg = std::max(
         errors.max_yaw_column_deg, std::abs(std::remainder(values[4] - truth_yaw_deg, 360.0)));
     ++rows;
@@ -188,7 +187,7 @@ TEST(GeorefCli, Pf6OnARecordingWithoutImuOrientationSaysSo) {
 struct CsvCase {
   std::filesystem::path trajectory, fixes;
   geo::Geodetic origin{60.5, 25.0, 80.0};
-  lie::SE3 T_enu_world{lie::SO3::fromRollPitchYaw(0.0, 0.0, 37.0 / kDeg),
+  lie::SE3 T_enu_world{lie::SO3::fromRollPitchYaw(0.0, 0.0, 37.0 * kRadPerDeg),
                        Eigen::Vector3d(250.0, -120.0, 3.0)};
 };
 
@@ -323,9 +322,8 @@ TEST(GeorefCli, TaigaRunGeoreferencesItsTrajectoryAndMapWhenTheRecordingHasFixes
     max_horizontal_m = std::max(max_horizontal_m, std::hypot(v[1] - truth_grid.x(),
                                                              v[2] - truth_grid.y()));
     max_height_m = std::max(max_height_m, std::abs(v[3] - truth_grid.z()));
-    const Eigen::Vector3d x_simworld = T_simworld_body.rotation().matrix().col(0);
-    const double truth_yaw_deg = std::atan2(x_simworld.y(), x_simworld.x()) * kDeg +
-                                 truth["yaw_grid_world_deg"].as<double>();
+    const double truth_yaw_deg =
+        T_simworld_body.rotation().yaw() * kDegPerRad + truth["yaw_grid_world_deg"].as<double>();
     max_yaw_deg = std::max(max_yaw_deg, std::abs(std::remainder(v[4] - truth_yaw_deg, 360.0)));
     min_e = std::min(min_e, v[1]), max_e = std::max(max_e, v[1]);
     min_n = std::min(min_n, v[2]), max_n = std::max(max_n, v[2]);

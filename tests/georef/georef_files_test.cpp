@@ -1,9 +1,17 @@
-// The fixes CSV reader (the format of docs/georeferencing.md) and the georef.yaml writer.
+// The fixes CSV reader (the format of docs/georeferencing.md) and the georef.yaml and
+// trajectory.geojson writers.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
 #include "../support/temp_dir.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/georef/georef_files.hpp"
 
@@ -94,13 +102,54 @@ TEST(GeorefYaml, HoldsTheTransformsSigmasAndCountsAtFullPrecision) {
   EXPECT_EQ(yaml["enu_origin"]["latitude_deg"].as<double>(), 61.000000123456789);
   EXPECT_EQ(yaml["T_enu_world"][0][3].as<double>(), 1.0 / 3.0);
   EXPECT_EQ(yaml["T_epsg_world"][0][3].as<double>(), 364808.14192166715);
-  EXPECT_NEAR(yaml["T_enu_world_roll_pitch_yaw_deg"][2].as<double>(), 0.3 * 180.0 / M_PI, 1e-12);
-  EXPECT_NEAR(yaml["sigma"]["yaw_deg"].as<double>(), 0.003 * 180.0 / M_PI, 1e-12);
+  EXPECT_NEAR(yaml["T_enu_world_roll_pitch_yaw_deg"][2].as<double>(), 0.3 * kDegPerRad, 1e-12);
+  EXPECT_NEAR(yaml["sigma"]["yaw_deg"].as<double>(), 0.003 * kDegPerRad, 1e-12);
   EXPECT_EQ(yaml["sigma"]["north_m"].as<double>(), 0.2);
   EXPECT_EQ(yaml["fixes"]["total"].as<int>(), 50);
   EXPECT_EQ(yaml["fixes"]["gated_sigma"].as<int>(), 8);
   EXPECT_EQ(yaml["fixes"]["used"].as<int>(), 40);
   EXPECT_EQ(yaml["fixes"]["outliers"].as<int>(), 2);
+}
+
+TEST(GeorefYaml, QuotedNamesAndNonFiniteSigmasReadBack) {
+  test::TempDir dir;
+  GeorefReport report;
+  report.method = "closed";
+  report.trajectory_file = R"(runs/a "b"\c: #1.tum)";
+  report.gnss_file = "fixes.csv";
+  report.fit.sigma << 0.1, 0.2, 0.3, 0.001, 0.002, std::numeric_limits<double>::quiet_NaN();
+  report.fit.sigma[2] = std::numeric_limits<double>::infinity();
+  report.fit.converged = false;
+  writeGeorefYaml(dir.file("georef.yaml"), report);
+  const YAML::Node yaml = YAML::LoadFile(dir.file("georef.yaml").string());
+  EXPECT_EQ(yaml["trajectory"].as<std::string>(), report.trajectory_file);
+  EXPECT_EQ(yaml["gnss"].as<std::string>(), "fixes.csv");
+  EXPECT_TRUE(std::isnan(yaml["sigma"]["yaw_deg"].as<double>()));
+  EXPECT_EQ(yaml["sigma"]["up_m"].as<double>(), std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(yaml["converged"].as<bool>());
+}
+
+TEST(GeoJson, IsALineStringInTheNamedCrsAtFullPrecision) {
+  test::TempDir dir;
+  const std::vector<GridPose> poses{{100.25, 364808.14192166715, 6765367.581224121, 120.1, 10.0},
+                                    {100.35, 364809.0000000001, 6765368.5, -0.3, 11.0}};
+  writeGeoJson(dir.file("trajectory.geojson"), poses, 3067, R"(walk "1")");
+  std::ifstream in(dir.file("trajectory.geojson"));
+  std::stringstream text;
+  text << in.rdbuf();
+  const nlohmann::json geojson = nlohmann::json::parse(text.str());
+  EXPECT_EQ(geojson["type"], "FeatureCollection");
+  EXPECT_EQ(geojson["name"], R"(walk "1")");
+  EXPECT_EQ(geojson["crs"]["properties"]["name"], "urn:ogc:def:crs:EPSG::3067");
+  const nlohmann::json& feature = geojson["features"][0];
+  EXPECT_EQ(feature["properties"]["t_start_s"].get<double>(), 100.25);
+  EXPECT_EQ(feature["properties"]["t_end_s"].get<double>(), 100.35);
+  const nlohmann::json& coordinates = feature["geometry"]["coordinates"];
+  ASSERT_EQ(coordinates.size(), 2u);
+  EXPECT_EQ(coordinates[0][0].get<double>(), 364808.14192166715);
+  EXPECT_EQ(coordinates[0][1].get<double>(), 6765367.581224121);
+  EXPECT_EQ(coordinates[1][0].get<double>(), 364809.0000000001);
+  EXPECT_EQ(coordinates[1][2].get<double>(), -0.3);
 }
 
 }  // namespace

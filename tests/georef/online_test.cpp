@@ -7,15 +7,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <random>
+
+#include "taiga/core/angles.hpp"
 
 namespace taiga::georef {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 const geo::Geodetic kOrigin{61.0, 24.5, 120.0};
-const lie::SE3 kTruth_T_enu_world(lie::SO3::fromRollPitchYaw(0.0, 0.0, 37.0 * kDeg),
+const lie::SE3 kTruth_T_enu_world(lie::SO3::fromRollPitchYaw(0.0, 0.0, 37.0 * kRadPerDeg),
                                   Eigen::Vector3d(312.5, -457.25, 23.1));
 
 /// A 120 s walk around a 20 m circle, one pose per 0.1 s; fixes at 1 Hz with 0.5 m white noise.
@@ -80,7 +80,7 @@ TEST(OnlineGeoreferencer, WaitsForTheHeadingThenRecoversTheTransform) {
   // 121 fixes of 0.5 m spread over a 20 m circle: yaw sigma ~ 0.5 / (11 * 20) rad = 0.13 deg.
   const Eigen::Vector3d rotation_error =
       (fit.T_enu_world.rotation() * kTruth_T_enu_world.rotation().inverse()).Log();
-  EXPECT_LT(std::abs(rotation_error.z()), 0.5 * kDeg);
+  EXPECT_LT(std::abs(rotation_error.z()), 0.5 * kRadPerDeg);
   // Positions in the grid (the estimator's ENU origin is its first fix, not kOrigin).
   const geo::CoordinateConverter converter(3067);
   for (const StampedPose& p : {walk.poses.front(), walk.poses.back()}) {

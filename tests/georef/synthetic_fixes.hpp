@@ -7,12 +7,13 @@
 #include <random>
 #include <vector>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/georef/association.hpp"
 
 namespace taiga::georef::test {
 
-inline double deg(double degrees) { return degrees * std::numbers::pi / 180.0; }
+inline double deg(double degrees) { return degrees * kRadPerDeg; }
 
 /// A 300 s walk at 10 Hz around a rounded loop of about 90 x 60 m that starts at the world
 /// origin, heights over gentle terrain (+-2 m), heading along the path, small roll and pitch.

@@ -2,16 +2,14 @@
 
 #include <gtest/gtest.h>
 
-#include <numbers>
 #include <random>
 #include <vector>
 
 #include "imu_test_motion.hpp"
+#include "taiga/core/angles.hpp"
 
 namespace taiga::imu {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Scenario {
   std::vector<lie::SE3> poses;  ///< in a world frame tilted by R_tilt
@@ -44,26 +42,27 @@ Scenario tiltedScenario(const lie::SO3& R_tilt, double pose_noise_m = 0.0) {
 }
 
 TEST(GravityAlignment, FindsGravityAndVelocitiesInATiltedFrame) {
-  const lie::SO3 R_tilt = lie::SO3::fromRollPitchYaw(4 * kDeg, -6 * kDeg, 30 * kDeg);
+  const lie::SO3 R_tilt =
+      lie::SO3::fromRollPitchYaw(4 * kRadPerDeg, -6 * kRadPerDeg, 30 * kRadPerDeg);
   const Scenario s = tiltedScenario(R_tilt);
   const GravityAlignment a = alignGravity(s.poses, s.increments, 9.81);
   const Vector3 g_true = R_tilt * test::kGravityWorld;
-  EXPECT_LT(std::acos(a.gravity_world.normalized().dot(g_true.normalized())), 0.02 * kDeg);
+  EXPECT_LT(std::acos(a.gravity_world.normalized().dot(g_true.normalized())), 0.02 * kRadPerDeg);
   EXPECT_NEAR(a.estimated_magnitude_mps2, 9.81, 0.01);
   ASSERT_EQ(a.v_world.size(), s.poses.size());
   for (std::size_t k = 0; k < s.poses.size(); ++k)
     EXPECT_LT((a.v_world[k] - s.v_tilted[k]).norm(), 0.005) << k;
   // Levelling undoes the tilt (up to a heading, which gravity cannot tell).
   const Vector3 up = (a.R_levelled_world * R_tilt) * Vector3::UnitZ();
-  EXPECT_LT(std::acos(std::min(1.0, up.z())), 0.02 * kDeg);
+  EXPECT_LT(std::acos(std::min(1.0, up.z())), 0.02 * kRadPerDeg);
 }
 
 TEST(GravityAlignment, NoisyPosesStillGiveTheTiltToAFractionOfADegree) {
-  const lie::SO3 R_tilt = lie::SO3::fromRollPitchYaw(-3 * kDeg, 5 * kDeg, 0.0);
+  const lie::SO3 R_tilt = lie::SO3::fromRollPitchYaw(-3 * kRadPerDeg, 5 * kRadPerDeg, 0.0);
   const Scenario s = tiltedScenario(R_tilt, 0.01);
   const GravityAlignment a = alignGravity(s.poses, s.increments, 9.81);
   const Vector3 g_true = R_tilt * test::kGravityWorld;
-  EXPECT_LT(std::acos(a.gravity_world.normalized().dot(g_true.normalized())), 0.5 * kDeg);
+  EXPECT_LT(std::acos(a.gravity_world.normalized().dot(g_true.normalized())), 0.5 * kRadPerDeg);
   EXPECT_NEAR(a.estimated_magnitude_mps2, 9.81, 0.3);
 }
 

@@ -2,17 +2,15 @@
 
 #include <gtest/gtest.h>
 
-#include <numbers>
 #include <random>
 #include <vector>
 
 #include "imu_test_motion.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 
 namespace taiga::imu {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// Readings of a sensor at rest with orientation R_world_body, gyro bias and white noise.
 std::vector<ImuSample> restingSamples(const lie::SO3& R_world_body, const Vector3& gyro_bias,
@@ -38,12 +36,13 @@ double tiltError(const lie::SO3& estimate, const lie::SO3& truth) {
 }
 
 TEST(Initialization, AtRestFindsTiltAndGyroBias) {
-  const lie::SO3 R_true = lie::SO3::fromRollPitchYaw(8 * kDeg, -5 * kDeg, 40 * kDeg);
+  const lie::SO3 R_true =
+      lie::SO3::fromRollPitchYaw(8 * kRadPerDeg, -5 * kRadPerDeg, 40 * kRadPerDeg);
   const Vector3 gyro_bias(0.01, -0.004, 0.007);
   const InitialState init = initializeFromImu(restingSamples(R_true, gyro_bias));
   EXPECT_TRUE(init.at_rest);
   EXPECT_FALSE(init.from_orientation);
-  EXPECT_LT(tiltError(init.state.R_world_body, R_true), 0.1 * kDeg);
+  EXPECT_LT(tiltError(init.state.R_world_body, R_true), 0.1 * kRadPerDeg);
   EXPECT_LT((init.bias.gyro_radps - gyro_bias).norm(), 5e-4);
   EXPECT_NEAR(init.state.R_world_body.matrix()(1, 0), 0.0, 1e-9);  // zero heading
   EXPECT_TRUE(init.state.v_world.isZero());
@@ -62,13 +61,14 @@ TEST(Initialization, MovingFromTheStartGivesAnApproximateTiltAndLoosePriors) {
   // The motion tilts by up to 20 degrees and accelerates at up to 1.3 m/s^2: the mean specific
   // force gives the tilt of the window's middle to a few degrees.
   EXPECT_LT(tiltError(init.state.R_world_body, test::WavyMotion::state(0.5).R_world_body),
-            8 * kDeg);
+            8 * kRadPerDeg);
   EXPECT_GE(init.covariance(6, 6), 0.5);
-  EXPECT_GE(init.covariance(3, 3), std::pow(2.0 * kDeg, 2));
+  EXPECT_GE(init.covariance(3, 3), std::pow(2.0 * kRadPerDeg, 2));
 }
 
 TEST(Initialization, UsesAnEnuOrientationWholeAndTurnsNedIntoEnu) {
-  const lie::SO3 R_enu_imu = lie::SO3::fromRollPitchYaw(3 * kDeg, 2 * kDeg, 70 * kDeg);
+  const lie::SO3 R_enu_imu =
+      lie::SO3::fromRollPitchYaw(3 * kRadPerDeg, 2 * kRadPerDeg, 70 * kRadPerDeg);
   std::vector<ImuSample> samples = restingSamples(R_enu_imu, Vector3::Zero());
   for (ImuSample& s : samples)
     s.orientation = ImuOrientation{R_enu_imu.quaternion(), OrientationReference::kEnu};

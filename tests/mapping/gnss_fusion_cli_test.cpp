@@ -6,13 +6,13 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <fstream>
-#include <numbers>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
 #include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/geo/coordinates.hpp"
 #include "taiga/io/trajectory_io.hpp"
@@ -73,7 +73,7 @@ TEST(GnssFusionCli, TaigaRunFusesTheFixesAndReportsTheMapToEnuTransform) {
                                     fusion["enu_origin"]["longitude_deg"].get<double>(),
                                     fusion["enu_origin"]["height_ellipsoid_m"].get<double>()};
   const geo::Geodetic sim_origin{61.0, 24.5, 120.0};  // the handheld-loop scenario's
-  const double world_yaw_rad = 30.0 * std::numbers::pi / 180.0;
+  const double world_yaw_rad = 30.0 * kRadPerDeg;
   Eigen::Matrix3d R_enu_simworld;
   R_enu_simworld << std::cos(world_yaw_rad), -std::sin(world_yaw_rad), 0,
       std::sin(world_yaw_rad), std::cos(world_yaw_rad), 0, 0, 0, 1;

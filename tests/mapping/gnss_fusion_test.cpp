@@ -6,12 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "../support/temp_dir.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/geo/coordinates.hpp"
 #include "taiga/georef/fit.hpp"
 #include "taiga/mapping/gnss_fusion.hpp"
@@ -21,11 +21,10 @@
 namespace taiga::mapping {
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr double kStartS = 1000.0;  // keyframe k at kStartS + k, 1 m apart (1 m/s)
 const geo::Geodetic kOrigin{61.0, 24.5, 120.0};
 // Where the map lies in ENU at kOrigin: heading 35 deg, origin 120 m east, 45 m south, 3 m up.
-const lie::SE3 kTrueEnuWorld(lie::SO3::fromRollPitchYaw(0, 0, 35.0 * kDegToRad), {120, -45, 3});
+const lie::SE3 kTrueEnuWorld(lie::SO3::fromRollPitchYaw(0, 0, 35.0 * kRadPerDeg), {120, -45, 3});
 
 // 200 keyframes 1 m apart: 140 m straight, a 90 deg turn to the left, 60 m on.
 std::vector<lie::SE3> trueRectangle() {
@@ -34,9 +33,10 @@ std::vector<lie::SE3> trueRectangle() {
   for (int k = 0; k < 200; ++k) {
     poses.push_back(T_world_body);
     const bool corner = k == 139;
-    T_world_body = T_world_body * lie::SE3::Exp((lie::Vector6() << 1, 0, 0, 0, 0,
-                                                 corner ? 90.0 * kDegToRad : 0.0)
-                                                    .finished());
+    T_world_body =
+        T_world_body *
+        lie::SE3::Exp(
+            (lie::Vector6() << 1, 0, 0, 0, 0, corner ? 90.0 * kRadPerDeg : 0.0).finished());
   }
   return poses;
 }
@@ -47,9 +47,9 @@ std::vector<lie::SE3> driftingOdometry(const std::vector<lie::SE3>& truth) {
   std::vector<lie::SE3> odometry{truth.front()};
   for (std::size_t k = 1; k < truth.size(); ++k) {
     const lie::SE3 step = truth[k - 1].inverse() * truth[k];
-    odometry.push_back(odometry.back() *
-                       lie::SE3(step.rotation() * lie::SO3::Exp(Eigen::Vector3d(0, 0, 0.02 * kDegToRad)),
-                                step.translation() * 1.002));
+    odometry.push_back(odometry.back() * lie::SE3(step.rotation() * lie::SO3::Exp(Eigen::Vector3d(
+                                                                        0, 0, 0.02 * kRadPerDeg)),
+                                                  step.translation() * 1.002));
   }
   return odometry;
 }
@@ -172,7 +172,7 @@ double ateAfterAlignment(const std::vector<lie::SE3>& poses, const std::vector<l
   return georef::fitClosed(pairs, options).residual_rms_m;
 }
 
-double yawDeg(const lie::SE3& T) { return georef::rollPitchYaw(T.rotation()).z() / kDegToRad; }
+double yawDeg(const lie::SE3& T) { return georef::rollPitchYaw(T.rotation()).z() * kDegPerRad; }
 
 TEST(GnssFusion, RecoversTheMapToEnuTransformAndRemovesTheDrift) {
   const std::vector<lie::SE3> truth = trueRectangle();

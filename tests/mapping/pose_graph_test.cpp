@@ -4,15 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <vector>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/mapping/pose_graph.hpp"
 
 namespace taiga::mapping {
 namespace {
-
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 // 160 keyframes 1 m apart around a 40 m x 40 m square, turning 90 deg at each corner.
 std::vector<lie::SE3> trueSquareLoop() {
@@ -20,7 +18,7 @@ std::vector<lie::SE3> trueSquareLoop() {
   lie::SE3 T_world_body;
   for (int k = 0; k < 160; ++k) {
     poses.push_back(T_world_body);
-    const double yaw_step = (k % 40 == 39) ? 90.0 * kDegToRad : 0.0;
+    const double yaw_step = (k % 40 == 39) ? 90.0 * kRadPerDeg : 0.0;
     T_world_body = T_world_body * lie::SE3::Exp((lie::Vector6() << 1, 0, 0, 0, 0, yaw_step).finished());
   }
   return poses;
@@ -32,7 +30,7 @@ std::vector<lie::SE3> driftingOdometry(const std::vector<lie::SE3>& truth) {
   std::vector<lie::SE3> odometry{truth.front()};
   for (std::size_t k = 1; k < truth.size(); ++k) {
     lie::SE3 step = truth[k - 1].inverse() * truth[k];
-    step = lie::SE3(step.rotation() * lie::SO3::Exp(Eigen::Vector3d(0, 0, 0.02 * kDegToRad)),
+    step = lie::SE3(step.rotation() * lie::SO3::Exp(Eigen::Vector3d(0, 0, 0.02 * kRadPerDeg)),
                     step.translation() * 1.003);
     odometry.push_back(odometry.back() * step);
   }
@@ -96,7 +94,7 @@ TEST(PoseGraph, RefusesAFalseLoopAndKeepsItsPoses) {
   RelativePose false_loop = loopFromTruth(truth, 20, 150);
   false_loop.T_from_to =
       false_loop.T_from_to *
-      lie::SE3::Exp((lie::Vector6() << 4.0, 0.0, 0.0, 0.0, 0.0, 20 * kDegToRad).finished());
+      lie::SE3::Exp((lie::Vector6() << 4.0, 0.0, 0.0, 0.0, 0.0, 20 * kRadPerDeg).finished());
   EXPECT_GT(graph.addLoopIfConsistent(false_loop, 50.0), 50.0);
   EXPECT_EQ(graph.loops().size(), 1u);
   for (std::size_t k = 0; k < before.size(); ++k)

@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
-#include <numbers>
 #include <vector>
 
 #include "registration_data.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/registration/kdtree.hpp"
 #include "taiga/registration/registration.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
@@ -129,9 +129,8 @@ TEST(Registration, FacadeFillsTheFitnessScore) {
   // errors it need not: on this pair the points without overlap dominate the mean, and a pose
   // 1 deg off scored 0.326 m^2 against 0.347 m^2 at the solution.)
   const lie::SE3 guess =
-      data().T_target_source *
-      lie::SE3(lie::SO3::fromAxisAngle({0, 0, 1}, 10.0 * std::numbers::pi / 180.0),
-               Eigen::Vector3d(1.0, 0.0, 0.0));
+      data().T_target_source * lie::SE3(lie::SO3::fromAxisAngle({0, 0, 1}, 10.0 * kRadPerDeg),
+                                        Eigen::Vector3d(1.0, 0.0, 0.0));
   const RegistrationResult r = registerClouds(data().source, data().target, guess, config);
   ASSERT_TRUE(r.converged) << r.reason;
   const KdTree tree(data().target);

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <numbers>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/lie/se3.hpp"
 
@@ -42,7 +42,7 @@ struct PoseError {
 };
 inline PoseError poseError(const lie::SE3& estimate, const lie::SE3& reference) {
   const lie::SE3 delta = reference.inverse() * estimate;
-  return {delta.translation().norm(), delta.rotation().Log().norm() * 180.0 / std::numbers::pi};
+  return {delta.translation().norm(), delta.rotation().Log().norm() * kDegPerRad};
 }
 
 /// A perturbation with a translation of uniform random length in [0, max_m] along a random
@@ -53,7 +53,7 @@ inline lie::SE3 randomPerturbation(std::mt19937& rng, double max_m, double max_d
   const Eigen::Vector3d dir = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
   const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
   const double t = max_m * uniform(rng);
-  const double angle = max_deg * std::numbers::pi / 180.0 * uniform(rng);
+  const double angle = max_deg * kRadPerDeg * uniform(rng);
   return lie::SE3(lie::SO3::Exp(axis * angle), dir * t);
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../support/temp_dir.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
 #include "taiga/io/recording.hpp"
@@ -20,7 +21,6 @@
 
 namespace taiga::sim {
 namespace {
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 Motion makeHarvester(double duration_s, MotionParams params = scenarioByName("harvester").motion) {
   return Motion(params, duration_s, 3, Terrain(scenarioByName("harvester").forest, 3));
@@ -91,8 +91,8 @@ TEST(HarvesterMotion, ShakesInBurstsWhileATreeIsHandled) {
   }
   EXPECT_GT(shaking_acc, 3.0);  // several m/s^2
   EXPECT_LT(shaking_acc, 15.0);
-  EXPECT_GT(shaking_rate, 2.0 * kDeg);  // some deg/s
-  EXPECT_LT(shaking_rate, 15.0 * kDeg);
+  EXPECT_GT(shaking_rate, 2.0 * kRadPerDeg);  // some deg/s
+  EXPECT_LT(shaking_rate, 15.0 * kRadPerDeg);
   EXPECT_LT(driving_acc, 1.0);
 }
 

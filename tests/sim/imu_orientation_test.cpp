@@ -5,15 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
-#include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/lie/so3.hpp"
 #include "taiga/sim/imu.hpp"
 #include "taiga/sim/motion.hpp"
 
 namespace taiga::sim {
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct AttitudeError {
   double tilt_rad;
@@ -43,7 +42,7 @@ TEST(ImuOrientation, ExactWithoutNoiseInTheWorldFramesHeading) {
   const double world_yaw_deg = 30.0;
   ImuSimulator imu(params, 1, world_yaw_deg);
   const Eigen::Matrix3d R_enu_world =
-      Eigen::AngleAxisd(world_yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(world_yaw_deg * kRadPerDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   for (int k = 0; k < 2000; ++k) {
     const double t = imu.nextTime_s();
     const ImuSample sample = imu.next(motion);
@@ -85,15 +84,15 @@ TEST(ImuOrientation, TiltErrorSmallAndSlowHeadingDriftsFromItsOffset) {
     ++n;
   }
   // Tilt: two Gauss-Markov axes of 0.7 deg: RMS 1.0 deg (over 10 correlation times: +-50 %).
-  const double tilt_rms_deg = std::sqrt(tilt_sum_sq / n) / kDeg;
+  const double tilt_rms_deg = std::sqrt(tilt_sum_sq / n) * kDegPerRad;
   EXPECT_GT(tilt_rms_deg, 0.4);
   EXPECT_LT(tilt_rms_deg, 1.6);
   // Slowly varying: at 200 Hz and tau = 60 s a step is ~0.7 deg x sqrt(2 dt / tau) ~ 0.013 deg.
-  EXPECT_LT(max_tilt_step / kDeg, 0.06);
+  EXPECT_LT(max_tilt_step * kDegPerRad, 0.06);
   // Heading: starts at the constant offset, then a random walk of 0.15 deg/sqrt(s): 3.7 deg
   // 1-sigma after 600 s (bounded at 4.5 sigma, and it must have moved).
-  EXPECT_NEAR(heading_at_start / kDeg, 35.0, 0.05);
-  const double drift_deg = (heading_at_end - heading_at_start) / kDeg;
+  EXPECT_NEAR(heading_at_start * kDegPerRad, 35.0, 0.05);
+  const double drift_deg = (heading_at_end - heading_at_start) * kDegPerRad;
   EXPECT_LT(std::abs(drift_deg), 4.5 * 0.15 * std::sqrt(duration_s));
   EXPECT_GT(std::abs(drift_deg), 0.05);
   std::cout << "tilt error RMS " << tilt_rms_deg << " deg, heading drift " << drift_deg

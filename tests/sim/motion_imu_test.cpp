@@ -6,6 +6,7 @@
 #include <numeric>
 #include <vector>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/sim/imu.hpp"
 #include "taiga/sim/motion.hpp"
 
@@ -96,7 +97,6 @@ TEST(WalkingMotion, PausesStopTheWalkForTheirDuration) {
 }
 
 TEST(WalkingMotion, FastTurnsReachAboutNinetyDegreesPerSecond) {
-  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
   auto maxYawRate = [](const Motion& motion, double duration_s) {
     double fastest = 0.0;
     for (double t = 0.0; t < duration_s; t += 0.005)

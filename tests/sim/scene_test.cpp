@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/sim/gnss.hpp"
 #include "taiga/sim/scenario.hpp"
 
@@ -72,7 +73,7 @@ TEST(Scene, StandStatisticsMatchTheScenario) {
       EXPECT_LE(t.dbh_m, 0.50);
       EXPECT_GE(t.height_m, 10.0);
       EXPECT_LE(t.height_m, 28.0);
-      EXPECT_LE(t.lean_rad, 8.0 * std::numbers::pi / 180.0);
+      EXPECT_LE(t.lean_rad, 8.0 * kRadPerDeg);
       EXPECT_LT(t.crown_base_m, t.height_m);
       // Stems stand on the ground and off the walked path (the x axis from -10 to 10 m).
       EXPECT_NEAR(t.base_world.z(), scene.terrain().height(t.base_world.x(), t.base_world.y()),
@@ -172,7 +173,7 @@ TEST(Geodesy, EnuToGeodeticIsExactAndInvertible) {
   EXPECT_NEAR(same.height_m, 120.0, 1e-6);
   // 1 km north: the WGS84 meridian radius of curvature at 61 N is 6 384 418 m (a(1-e2)/W^3).
   const Geodetic north = enuToGeodetic(origin, Eigen::Vector3d(0, 1000, 0));
-  EXPECT_NEAR(north.latitude_deg - 61.0, 1000.0 / 6384418.0 * 180.0 / std::numbers::pi, 2e-7);
+  EXPECT_NEAR(north.latitude_deg - 61.0, 1000.0 / 6384418.0 * kDegPerRad, 2e-7);
   const Eigen::Vector3d p(-321.5, 845.25, 12.5);
   EXPECT_LT((geodeticToEnu(origin, enuToGeodetic(origin, p)) - p).norm(), 1e-6);
 }

@@ -6,12 +6,12 @@
 #include <algorithm>
 #include <fstream>
 #include <iostream>
-#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "../support/temp_dir.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/geo/coordinates.hpp"
@@ -79,7 +79,7 @@ TEST(TruthOutputs, TreesCsvHoldsEveryStemAtFullPrecision) {
     EXPECT_EQ(std::stod(row[3]), tree.base_world.z());
     EXPECT_EQ(std::stod(row[4]), tree.dbh_m);
     EXPECT_EQ(std::stod(row[5]), tree.height_m);
-    EXPECT_NEAR(std::stod(row[6]), tree.lean_rad * 180.0 / std::numbers::pi, 1e-12);
+    EXPECT_NEAR(std::stod(row[6]), tree.lean_rad * kDegPerRad, 1e-12);
     EXPECT_TRUE(row[8] == "pine" || row[8] == "spruce" || row[8] == "birch") << row[8];
   }
 }

@@ -10,10 +10,10 @@
 //   none:                         the estimate as it is.
 //
 // Umeyama, "Least-squares estimation of transformation parameters between two point patterns",
-// IEEE PAMI 1991, as in evo's geometry.umeyama_alignment: the covariance of the centred
-// positions, its SVD U D V^T, R = U S V^T with S = diag(1, 1, det(U) det(V)), scale
-// c = trace(D S) / sigma_x^2 and t = mean_ref - c R mean_est. Alignment uses all associated pairs
-// (evo's default, --n_to_align all).
+// IEEE PAMI 1991, as in evo's geometry.umeyama_alignment (lie/umeyama.hpp, which georef's closed
+// fit uses too): the covariance of the centred positions, its SVD U D V^T, R = U S V^T with
+// S = diag(1, 1, det(U) det(V)), scale c = trace(D S) / sigma_x^2 and t = mean_ref - c R mean_est.
+// Alignment uses all associated pairs (evo's default, --n_to_align all).
 
 #include <string>
 #include <string_view>
@@ -36,9 +36,10 @@ struct AlignmentTransform {
   double scale = 1.0;
 };
 
-/// Umeyama's least-squares similarity taking `source` onto `target` (same size). Throws
-/// InputError when the covariance has rank < 2 (all points on one line, or a single point): the
-/// rotation about that line is then not determined, and evo refuses the same inputs.
+/// Umeyama's least-squares similarity taking `source` onto `target` (same size; lie::umeyama).
+/// Throws InputError when there are no points or the covariance has rank < 2 (all points on one
+/// line, or a single point): the rotation about that line is then not determined, and evo refuses
+/// the same inputs.
 AlignmentTransform umeyama(const std::vector<Eigen::Vector3d>& source,
                            const std::vector<Eigen::Vector3d>& target, bool with_scale);
 

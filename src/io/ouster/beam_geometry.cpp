@@ -4,10 +4,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "taiga/core/angles.hpp"
+
 namespace taiga::io::ouster {
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr double kMmToM = 1e-3;
 
 }  // namespace
@@ -23,8 +24,8 @@ BeamGeometry::BeamGeometry(const SensorInfo& info) {
     sin_encoder_[c] = std::sin(theta_e);
   }
   for (std::size_t row = 0; row < info.beam_altitude_angles_deg.size(); ++row) {
-    const double theta_a = -info.beam_azimuth_angles_deg[row] * kDegToRad;
-    const double phi = info.beam_altitude_angles_deg[row] * kDegToRad;
+    const double theta_a = -info.beam_azimuth_angles_deg[row] * kRadPerDeg;
+    const double phi = info.beam_altitude_angles_deg[row] * kRadPerDeg;
     cos_azimuth_.push_back(std::cos(theta_a));
     sin_azimuth_.push_back(std::sin(theta_a));
     cos_altitude_.push_back(std::cos(phi));

@@ -1,9 +1,9 @@
 #include "taiga/io/ouster/imu_packet.hpp"
 
 #include <cmath>
-#include <numbers>
 
 #include "byte_reader.hpp"
+#include "taiga/core/angles.hpp"
 
 namespace taiga::io::ouster {
 namespace {
@@ -12,7 +12,6 @@ using detail::ByteReader;
 
 constexpr std::uint16_t kImuPacketType = 2;
 constexpr double kNsToS = 1e-9;
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 // LEGACY byte offsets (Ouster firmware user manual, "IMU Data Format").
 constexpr std::size_t kLegacyGyroTime = 16;
@@ -54,7 +53,7 @@ PacketStatus ImuPacketDecoder::decode(std::span<const std::uint8_t> bytes,
     ImuSample s;
     s.t_s = static_cast<double>(r.le<std::uint64_t>(kLegacyGyroTime)) * kNsToS;
     s.acceleration_imu_mps2 = vector3(r, kLegacyAcceleration) * kStandardGravity_mps2;
-    s.angular_velocity_imu_radps = vector3(r, kLegacyAngularVelocity) * kDegToRad;
+    s.angular_velocity_imu_radps = vector3(r, kLegacyAngularVelocity) * kRadPerDeg;
     if (usable(s)) {
       samples.push_back(s);
     } else {

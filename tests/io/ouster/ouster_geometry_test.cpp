@@ -7,6 +7,7 @@
 #include <random>
 
 #include "ouster_test_support.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/io/ouster/beam_geometry.hpp"
 
 namespace taiga::io::ouster {
@@ -68,7 +69,7 @@ TEST(OusterGeometry, BeamToLidarTransformAddsTheBeamOriginHeight) {
   const BeamGeometry geometry(info);
   const double n = std::hypot(30.0, 4.0);
   const double r = 5000.0;
-  const double phi = 10.0 * kPi / 180.0;
+  const double phi = 10.0 * kRadPerDeg;
   const Eigen::Vector3d p = geometry.pointInSensor(0, 0, static_cast<std::uint32_t>(r));
   EXPECT_NEAR(p.x(), ((r - n) * std::cos(phi) + 30.0) / 1000, 1e-12);
   EXPECT_NEAR(p.y(), 0.0, 1e-12);
