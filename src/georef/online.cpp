@@ -26,17 +26,6 @@ void OnlineGeoreferencer::addFix(const GnssFix& fix) {
   associatePending();
 }
 
-void OnlineGeoreferencer::changeWorldFrame(const lie::SE3& T_new_old) {
-  Trajectory moved;
-  for (const StampedPose& p : published_) moved.append(p.t_s, T_new_old * p.pose);
-  published_ = std::move(moved);
-  for (AssociatedFix& pair : associated_) {
-    pair.T_world_body = T_new_old * pair.T_world_body;
-    pair.p_world = T_new_old * pair.p_world;
-  }
-  if (estimate_) estimate_->fit.T_enu_world = estimate_->fit.T_enu_world * T_new_old.inverse();
-}
-
 void OnlineGeoreferencer::associatePending() {
   if (published_.empty()) return;
   // Fixes up to the newest published pose are settled; later ones wait.

@@ -59,10 +59,10 @@ void LocalMap::account(const Keyframe& keyframe, Change change) {
   apply(point_statistics_);
 }
 
-void LocalMap::addKeyframe(double t_s, const lie::SE3& T_odom_keyframe,
+void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
                            std::vector<Eigen::Vector3d> points_in_keyframe) {
   finishPendingBuild();  // it reads the statistics that change now
-  keyframes_.push_back({t_s, T_odom_keyframe, std::move(points_in_keyframe)});
+  keyframes_.push_back({id, T_odom_keyframe, std::move(points_in_keyframe)});
   account(keyframes_.back(), Change::kAdd);
   while (static_cast<int>(keyframes_.size()) > max_keyframes_) {
     account(keyframes_.front(), Change::kRemove);
@@ -72,13 +72,13 @@ void LocalMap::addKeyframe(double t_s, const lie::SE3& T_odom_keyframe,
   registrations_since_keyframe_ = 0;
 }
 
-void LocalMap::repose(const std::function<lie::SE3(double t_s, const lie::SE3& T_odom_keyframe)>&
+void LocalMap::repose(const std::function<lie::SE3(std::uint64_t id, const lie::SE3& T_odom_keyframe)>&
                           T_odom_keyframe_at) {
   finishPendingBuild();
   for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
   point_statistics_.clear();
   for (Keyframe& keyframe : keyframes_) {
-    keyframe.T_odom_keyframe = T_odom_keyframe_at(keyframe.t_s, keyframe.T_odom_keyframe);
+    keyframe.T_odom_keyframe = T_odom_keyframe_at(keyframe.id, keyframe.T_odom_keyframe);
     account(keyframe, Change::kAdd);
   }
   in_use_ = {};  // so that beginRegistration() waits for the structures in the new frame

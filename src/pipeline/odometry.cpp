@@ -182,10 +182,10 @@ void Odometry::maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in
         config_.keyframe_rotation_weight_m_per_rad * moved.tail<3>().norm();
     if (travelled_m < config_.keyframe_distance_m) return;
   }
-  outcome.keyframe = true;
+  outcome.keyframe_id = keyframes_made_++;
   last_keyframe_T_odom_body_ = outcome.T_odom_body;
   local_map_.addKeyframe(
-      outcome.t_s, outcome.T_odom_body,
+      *outcome.keyframe_id, outcome.T_odom_body,
       preprocess::voxelFilter(cloud_in_body, config_.local_map_voxel_m).positions);
   outcome.keyframe_cloud_in_body = cloud_in_body;
 }

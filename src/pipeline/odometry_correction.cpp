@@ -20,9 +20,11 @@ bool movedApart(const lie::SE3& a, const lie::SE3& b) {
 
 }  // namespace
 
-void OdometryCorrection::addKeyframe(double t_s, const lie::SE3& T_odom_keyframe) {
+void OdometryCorrection::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe) {
+  if (id != T_odom_keyframes_.size())
+    throw std::logic_error("OdometryCorrection: keyframes must arrive in id order");
   T_odom_keyframes_.push_back(T_odom_keyframe);
-  local_map_.push_back({t_s, T_odom_keyframe});
+  local_map_.push_back({id, T_odom_keyframe});
   while (local_map_.size() > local_map_keyframes_) local_map_.pop_front();
 }
 
@@ -52,9 +54,9 @@ bool OdometryCorrection::apply(const mapping::GraphSnapshot& snapshot, bool keep
   }
   if (!bent) return false;
   for (std::size_t i = 0; i < local_map_.size(); ++i) local_map_[i].T_odom_keyframe = reshaped[i];
-  odometry.reposeLocalMap([&](double t_s, const lie::SE3& T_old_keyframe) {
+  odometry.reposeLocalMap([&](std::uint64_t id, const lie::SE3& T_old_keyframe) {
     for (const LocalMapKeyframe& keyframe : local_map_)
-      if (keyframe.t_s == t_s) return keyframe.T_odom_keyframe;
+      if (keyframe.id == id) return keyframe.T_odom_keyframe;
     return T_old_keyframe;  // a keyframe the run did not store: as it is
   });
   return true;

@@ -46,7 +46,7 @@ class OdometryCorrection {
 
   const lie::SE3& T_map_odom() const { return T_map_odom_; }
   /// Keyframe ids 0, 1, ... in order, at their pose in the odom frame.
-  void addKeyframe(double t_s, const lie::SE3& T_odom_keyframe);
+  void addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe);
   /// Takes the graph's snapshot: updates T_map_odom and, when the graph bent the local map's
   /// keyframes, rebuilds the odometry's local map. Returns whether it did.
   bool apply(const mapping::GraphSnapshot& snapshot, bool keep_gravity,
@@ -54,7 +54,7 @@ class OdometryCorrection {
 
  private:
   struct LocalMapKeyframe {
-    double t_s;
+    std::uint64_t id;
     lie::SE3 T_odom_keyframe;  ///< as the local map has it now
   };
 

@@ -1,6 +1,7 @@
 #include "taiga/pipeline/slam_system.hpp"
 
 #include <chrono>
+#include <stdexcept>
 #include <utility>
 
 #include "odometry_correction.hpp"
@@ -94,14 +95,14 @@ void SlamSystem::releaseHeld(const std::optional<lie::SE3>& T_odom_unlevelled) {
 void SlamSystem::handleOutcome(const ScanOutcome& outcome, bool live) {
   // 8. Publish the pose, with the graph's correction as the live system has it.
   for (SlamObserver* observer : observers_) observer->onScan(outcome, correction_->T_map_odom());
-  const bool new_keyframe = outcome.keyframe_cloud_in_body &&
-                            (store_.empty() || outcome.t_s > store_.info(store_.size() - 1).t_s);
-  if (!new_keyframe) return;
+  if (!outcome.keyframe_id) return;
   // 9. The keyframe's scan to disk; 10. into the mapping graph.
   const std::uint64_t id =
       store_.add(outcome.t_s, outcome.T_odom_body, *outcome.keyframe_cloud_in_body);
+  if (id != *outcome.keyframe_id)
+    throw std::logic_error("SlamSystem: the store's keyframe ids differ from the odometry's");
   mapping_thread_.addKeyframe(id, outcome.t_s, outcome.T_odom_body);
-  correction_->addKeyframe(outcome.t_s, outcome.T_odom_body);
+  correction_->addKeyframe(id, outcome.T_odom_body);
   for (SlamObserver* observer : observers_) observer->onKeyframe(id, outcome);
   // 11. Follow the graph. Keyframes released after levelling predate the local map, which
   // started over at levelling: nothing to follow for them.

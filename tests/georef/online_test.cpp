@@ -120,20 +120,5 @@ TEST(OnlineGeoreferencer, EndsWithTheOfflineRobustFitOfTheSameFixes) {
   EXPECT_DOUBLE_EQ(live->northing_m, offline_pose.northing_m);
 }
 
-TEST(OnlineGeoreferencer, FollowsAChangeOfTheOdometrysWorldFrame) {
-  const Walk walk = makeWalk();
-  // One georeferencer sees the poses in frame A throughout; the other sees frame B = T * A from
-  // the start, i.e. what the first would see after changeWorldFrame(T).
-  const lie::SE3 T_b_a(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.3), Eigen::Vector3d(5.0, -2.0, 0.5));
-  OnlineGeoreferencer in_a(whiteNoiseSettings()), in_b(whiteNoiseSettings());
-  feed(in_a, walk, lie::SE3());
-  feed(in_b, walk, T_b_a);
-  in_a.changeWorldFrame(T_b_a);
-  ASSERT_TRUE(in_a.estimate() && in_b.estimate());
-  EXPECT_LT((in_a.estimate()->fit.T_enu_world.matrix() - in_b.estimate()->fit.T_enu_world.matrix())
-                .norm(),
-            1e-6);
-}
-
 }  // namespace
 }  // namespace taiga::georef

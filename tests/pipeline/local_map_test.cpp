@@ -34,23 +34,23 @@ lie::SE3 registerFrom(LocalMap& map, const std::vector<Eigen::Vector3d>& source,
 TEST(LocalMap, ReposedKeyframesAreWhatTheNextRegistrationSees) {
   const std::vector<Eigen::Vector3d> corner = roomCorner();
   LocalMap map({1.0}, 0.2, 10, LocalMap::Target::kNdt);
-  map.addKeyframe(1.0, lie::SE3(), corner);
+  map.addKeyframe(0, lie::SE3(), corner);
   const lie::SE3 small_error(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.01), {0.1, -0.08, 0.05});
   EXPECT_LT(registerFrom(map, corner, small_error).translation().norm(), 0.01);
 
   // A second keyframe far away: the next registration would still use the structures built
   // before it (kScansOnPreviousMap), unless a repose forces the new ones.
   const lie::SE3 T_far(lie::SO3(), {100.0, 0.0, 0.0});
-  map.addKeyframe(2.0, T_far, corner);
+  map.addKeyframe(1, T_far, corner);
 
   // The graph moves the first keyframe 0.6 m and 3 deg: a scan of the corner now registers there.
   const lie::SE3 T_new_keyframe(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.05), {0.6, 0.3, 0.0});
-  std::vector<double> seen_t_s;
-  map.repose([&](double t_s, const lie::SE3& T_old) {
-    seen_t_s.push_back(t_s);
-    return t_s == 1.0 ? T_new_keyframe : T_old;
+  std::vector<std::uint64_t> seen_ids;
+  map.repose([&](std::uint64_t id, const lie::SE3& T_old) {
+    seen_ids.push_back(id);
+    return id == 0 ? T_new_keyframe : T_old;
   });
-  EXPECT_EQ(seen_t_s, (std::vector<double>{1.0, 2.0}));  // oldest first
+  EXPECT_EQ(seen_ids, (std::vector<std::uint64_t>{0, 1}));  // oldest first
   const lie::SE3 found = registerFrom(map, corner, T_new_keyframe * small_error);
   EXPECT_LT((found.translation() - T_new_keyframe.translation()).norm(), 0.01);
   EXPECT_LT((found.rotation().inverse() * T_new_keyframe.rotation()).angle(), 0.002);
@@ -59,13 +59,13 @@ TEST(LocalMap, ReposedKeyframesAreWhatTheNextRegistrationSees) {
 TEST(LocalMap, ReposingInPlaceKeepsTheMap) {
   const std::vector<Eigen::Vector3d> corner = roomCorner();
   LocalMap map({1.0}, 0.2, 10, LocalMap::Target::kNdt);
-  map.addKeyframe(1.0, lie::SE3(), corner);
-  map.addKeyframe(2.0, lie::SE3(lie::SO3(), {0.5, 0.0, 0.0}), corner);
+  map.addKeyframe(0, lie::SE3(), corner);
+  map.addKeyframe(1, lie::SE3(lie::SO3(), {0.5, 0.0, 0.0}), corner);
   const lie::SE3 guess(lie::SO3(), {0.2, 0.1, 0.0});
   registerFrom(map, corner, guess);  // on the structures without the second keyframe
   const lie::SE3 before = registerFrom(map, corner, guess);
   const std::size_t points = map.numPoints();
-  map.repose([](double, const lie::SE3& T_old) { return T_old; });
+  map.repose([](std::uint64_t, const lie::SE3& T_old) { return T_old; });
   EXPECT_EQ(map.numPoints(), points);
   EXPECT_LT((registerFrom(map, corner, guess).translation() - before.translation()).norm(), 1e-9);
 }

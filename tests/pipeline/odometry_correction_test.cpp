@@ -22,7 +22,7 @@ struct Fixture {
   explicit Fixture(int keyframes) {
     for (int k = 0; k < keyframes; ++k) {
       T_odom_keyframes.push_back(poseAt(1.0 * k, 0.05 * k));
-      correction.addKeyframe(0.5 * k, T_odom_keyframes.back());
+      correction.addKeyframe(static_cast<std::uint64_t>(k), T_odom_keyframes.back());
     }
   }
   /// The graph's poses of keyframes k - count + 1 ... k, each T_map_odom_i * T_odom_i.

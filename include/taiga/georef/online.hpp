@@ -37,8 +37,6 @@ class OnlineGeoreferencer {
   void addPose(double t_s, const lie::SE3& T_world_body);
   /// A fix (any time order relative to the poses); gated fixes are counted and dropped.
   void addFix(const GnssFix& fix);
-  /// The odometry re-expressed its world frame: p_new = T_new_old * p_old.
-  void changeWorldFrame(const lie::SE3& T_new_old);
 
   const std::optional<OnlineEstimate>& estimate() const { return estimate_; }
   /// The pose in the grid with the current estimate; nothing before the first estimate.

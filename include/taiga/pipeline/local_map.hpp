@@ -43,12 +43,12 @@ class LocalMap {
 
   /// Adds one keyframe (its time, pose and points in its body frame), drops the oldest keyframe
   /// beyond max_keyframes, and starts building the search structures in the background.
-  void addKeyframe(double t_s, const lie::SE3& T_odom_keyframe,
+  void addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
                    std::vector<Eigen::Vector3d> points_in_keyframe);
-  /// Moves every keyframe to a new pose (`T_odom_keyframe_at(t_s, old T_odom_keyframe)`), e.g.
+  /// Moves every keyframe to a new pose (`T_odom_keyframe_at(id, old T_odom_keyframe)`), e.g.
   /// the mapping graph's after a loop closure, and rebuilds the search structures from them. The
   /// next registration waits for them: the old ones hold the old poses.
-  void repose(const std::function<lie::SE3(double t_s, const lie::SE3& T_odom_keyframe)>&
+  void repose(const std::function<lie::SE3(std::uint64_t id, const lie::SE3& T_odom_keyframe)>&
                   T_odom_keyframe_at);
   /// Drops every keyframe.
   void clear();
@@ -81,7 +81,7 @@ class LocalMap {
   Target target_;
   registration::GicpConfig gicp_config_;
   struct Keyframe {
-    double t_s = 0.0;
+    std::uint64_t id = 0;
     lie::SE3 T_odom_keyframe;
     std::vector<Eigen::Vector3d> points_in_keyframe;
   };

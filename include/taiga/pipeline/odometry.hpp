@@ -65,8 +65,9 @@ struct ScanOutcome {
   std::string lidar_note;  ///< why a factor was rejected or inflated
   registration::RegistrationResult registration;
   std::size_t source_points = 0;
-  bool keyframe = false;
-  /// The full deskewed scan in the body frame at t_s, when this scan became a keyframe.
+  /// The keyframe this scan became (0, 1, ... in the order the odometry makes them; the
+  /// keyframe store's ids), and its full deskewed scan in the body frame at t_s.
+  std::optional<std::uint64_t> keyframe_id;
   std::optional<PointCloud> keyframe_cloud_in_body;
   /// IMU-rate poses T_odom_body after the previous state up to t_s (propagated, as published in
   /// real time).
@@ -98,10 +99,10 @@ class Odometry {
   /// True once the odom frame is final: levelled, or with no levelling to wait for (alignment
   /// off, lidar-only).
   bool odomFrameFinal() const;
-  /// Moves the local map's keyframes to `T_odom_keyframe_at(t_s, T_odom_keyframe)` and
+  /// Moves the local map's keyframes to `T_odom_keyframe_at(id, T_odom_keyframe)` and
   /// rebuilds it, e.g. in the shape the mapping graph gave them after a loop closure
   /// (MappingConfig::correct_odometry). The state stays. Between scans.
-  void reposeLocalMap(const std::function<lie::SE3(double t_s, const lie::SE3& T_odom_keyframe)>&
+  void reposeLocalMap(const std::function<lie::SE3(std::uint64_t id, const lie::SE3& T_odom_keyframe)>&
                           T_odom_keyframe_at) {
     local_map_.repose(T_odom_keyframe_at);
   }
@@ -121,6 +122,7 @@ class Odometry {
   std::unique_ptr<MotionPrior> motion_;
   LocalMap local_map_;
   std::optional<lie::SE3> last_keyframe_T_odom_body_;
+  std::uint64_t keyframes_made_ = 0;
 };
 
 }  // namespace taiga::pipeline
