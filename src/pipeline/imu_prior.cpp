@@ -12,9 +12,9 @@ namespace {
 /// IMU readings needed before the first scan is used, s.
 constexpr double kInitializationWindow_s = 0.5;
 
-lie::SE3 poseOf(const imu::NavState& state) { return lie::SE3(state.R_world_body, state.p_world); }
-
 }  // namespace
+
+lie::SE3 poseOf(const imu::NavState& state) { return lie::SE3(state.R_world_body, state.p_world); }
 
 std::unique_ptr<MotionPrior> makeMotionPrior(bool lidar_only, const OdometryConfig& config,
                                              const RigConfig& rig,

@@ -22,6 +22,9 @@
 
 namespace taiga::pipeline {
 
+/// T_odom_body of an IMU state.
+lie::SE3 poseOf(const imu::NavState& state);
+
 class ImuPrior final : public MotionPrior {
  public:
   ImuPrior(const OdometryConfig& config, const RigConfig& rig, const ScanPreparation& preparation,

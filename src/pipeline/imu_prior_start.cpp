@@ -14,12 +14,6 @@
 #include "taiga/preprocess/voxel_filter.hpp"
 
 namespace taiga::pipeline {
-namespace {
-
-lie::SE3 poseOf(const imu::NavState& state) { return lie::SE3(state.R_world_body, state.p_world); }
-
-}  // namespace
-
 std::pair<imu::InitialState, double> ImuPrior::initialAttitude(const io::Scan& first) {
   // With an IMU orientation output the attitude is that of one instant, the last reading used:
   // the state starts there, at the last reading before the first scan. A walking rig pitches by
