@@ -69,8 +69,7 @@ int run(const RunOptions& options) {
           "georef     {} of {} GNSS fixes ({}), residual {:.2f} m horizontal; 1-sigma {:.2f} m "
           "east, {:.2f} m north, {:.2f} deg yaw; EPSG:{} in georef/\n",
           s.georef->inliers, s.georef->fixes, s.georef->method, s.georef->horizontal_rms_m,
-          s.georef->sigma[0], s.georef->sigma[1], s.georef->sigma[5] * kDegPerRad,
-          s.georef->epsg);
+          s.georef->sigma[0], s.georef->sigma[1], s.georef->sigma[5] * kDegPerRad, s.georef->epsg);
     } else {
       fmt::print("georef     not georeferenced: {}\n", s.georef->skipped);
     }

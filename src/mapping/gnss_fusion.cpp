@@ -32,9 +32,9 @@ void GnssFusion::addFix(const GnssFix& fix) {
   if (prepared.fixes.empty()) return;
   if (!origin_) origin_ = prepared.origin;
   const georef::LocalFix& local = prepared.fixes.front();
-  const auto later = std::upper_bound(
-      queued_.begin(), queued_.end(), local.t_s,
-      [](double t_s, const georef::LocalFix& queued) { return t_s < queued.t_s; });
+  const auto later =
+      std::upper_bound(queued_.begin(), queued_.end(), local.t_s,
+                       [](double t_s, const georef::LocalFix& queued) { return t_s < queued.t_s; });
   queued_.insert(later, local);
 }
 
@@ -51,8 +51,8 @@ void GnssFusion::attach(const georef::LocalFix& fix, const PoseGraph& graph,
   // The antenna (at the body origin: no lever arm yet) in the nearest keyframe's body frame.
   const Eigen::Vector3d d_body = (graph.odometryPose(nearest).inverse() * T_odom_fix).translation();
 
-  const double dt_s = previous_fix_t_s_ ? std::abs(fix.t_s - *previous_fix_t_s_)
-                                        : config_.gnss_correlation_time_s;
+  const double dt_s =
+      previous_fix_t_s_ ? std::abs(fix.t_s - *previous_fix_t_s_) : config_.gnss_correlation_time_s;
   previous_fix_t_s_ = fix.t_s;
   Attached attached{
       .observation = {.keyframe = nearest,
@@ -98,11 +98,10 @@ void GnssFusion::tryStart(PoseGraph& graph) {
   std::vector<georef::AssociatedFix> pairs;
   for (const Attached& attached : attached_) {
     const GnssObservation& o = attached.observation;
-    pairs.push_back({.fix = {.t_s = attached.t_s,
-                             .p_enu = o.p_enu,
-                             .covariance_enu_m2 = o.covariance_enu_m2},
-                     .T_world_body = graph.pose(o.keyframe),
-                     .p_world = graph.pose(o.keyframe) * o.d_body});
+    pairs.push_back(
+        {.fix = {.t_s = attached.t_s, .p_enu = o.p_enu, .covariance_enu_m2 = o.covariance_enu_m2},
+         .T_world_body = graph.pose(o.keyframe),
+         .p_world = graph.pose(o.keyframe) * o.d_body});
   }
   double spread_m = 0.0;
   for (const georef::AssociatedFix& pair : pairs)
@@ -134,9 +133,10 @@ GnssFusionReport GnssFusion::report(const PoseGraph& graph) const {
   report.enu_origin = origin_;
   report.T_enu_map = graph.enuMap();
   const std::vector<double> whitened = graph.gnssWhitenedResiduals();
-  report.down_weighted = static_cast<std::size_t>(std::count_if(
-      whitened.begin(), whitened.end(),
-      [&](double norm) { return norm > config_.gnss_huber_sigmas; }));
+  report.down_weighted =
+      static_cast<std::size_t>(std::count_if(whitened.begin(), whitened.end(), [&](double norm) {
+        return norm > config_.gnss_huber_sigmas;
+      }));
   return report;
 }
 

@@ -59,10 +59,12 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   // The odometry's NDT passes (registrationConfigFor), after one at 3x its coarsest cells, all
   // neighbouring cells scored: the guess may be off by the drift since the candidate, and a
   // coarser pass widens the basin. NDT whatever the odometry's method, for that coarse pass.
-  registration::RegistrationConfig registration_config = registration::registrationConfigFor(odometry);
+  registration::RegistrationConfig registration_config =
+      registration::registrationConfigFor(odometry);
   registration_config.method = registration::Method::kNdt;
   std::vector<double>& coarse_m = registration_config.ndt.coarse_resolutions_m;
-  const double coarsest_m = coarse_m.empty() ? registration_config.ndt.resolution_m : coarse_m.front();
+  const double coarsest_m =
+      coarse_m.empty() ? registration_config.ndt.resolution_m : coarse_m.front();
   coarse_m.insert(coarse_m.begin(), 3.0 * coarsest_m);
   registration_config.ndt.search = registration::NeighbourSearch::kDirect7;
   const lie::SE3 guess_T_candidate_current = T_candidate_map * graph.pose(current);

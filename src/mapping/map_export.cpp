@@ -70,8 +70,9 @@ class NearestToCentreGrid {
   /// The kept points grouped by keyframe (in first-occupied order within a keyframe).
   std::vector<VoxelPoint> takePoints() {
     index_.clear();
-    std::stable_sort(points_.begin(), points_.end(),
-                     [](const VoxelPoint& a, const VoxelPoint& b) { return a.keyframe < b.keyframe; });
+    std::stable_sort(points_.begin(), points_.end(), [](const VoxelPoint& a, const VoxelPoint& b) {
+      return a.keyframe < b.keyframe;
+    });
     return std::move(points_);
   }
 
@@ -136,8 +137,8 @@ MapExportSummary exportMap(const KeyframeStore& store,
                            const std::vector<lie::SE3>& poses_T_map_body,
                            const std::filesystem::path& las_path, const MapExportOptions& options) {
   if (poses_T_map_body.size() != store.size())
-    throw std::invalid_argument(fmt::format("exportMap: {} poses for {} keyframes",
-                                            poses_T_map_body.size(), store.size()));
+    throw std::invalid_argument(
+        fmt::format("exportMap: {} poses for {} keyframes", poses_T_map_body.size(), store.size()));
   if (!(options.voxel_m >= 0.0) || !std::isfinite(options.voxel_m))
     throw InputError(fmt::format("--map-voxel {}: expected a voxel size >= 0 m", options.voxel_m));
 
@@ -147,9 +148,8 @@ MapExportSummary exportMap(const KeyframeStore& store,
   MapExportSummary summary;
   bool has_times = false, has_intensities = false, has_rings = false;
   for (std::uint64_t id = 0; id < store.size(); ++id) {
-    const PointCloud cloud_out =
-        toOutputFrame(store.load(id),
-                      options.T_out_map * Eigen::Affine3d(poses_T_map_body[id].matrix()));
+    const PointCloud cloud_out = toOutputFrame(
+        store.load(id), options.T_out_map * Eigen::Affine3d(poses_T_map_body[id].matrix()));
     summary.points_read += cloud_out.size();
     ++summary.keyframes;
     if (!grid) {

@@ -75,9 +75,7 @@ void Mapper::tryLoopClosure(std::size_t current, double t_s) {
 
 MappingThread::MappingThread(const MappingConfig& config, const OdometryConfig& odometry,
                              const KeyframeStore& store, MappingThreadOptions options)
-    : mapper_(config, odometry, store),
-      options_(std::move(options)),
-      worker_([this] { work(); }) {}
+    : mapper_(config, odometry, store), options_(std::move(options)), worker_([this] { work(); }) {}
 
 MappingThread::~MappingThread() {
   {
@@ -134,8 +132,7 @@ void MappingThread::publish(std::size_t id) {
   const std::vector<lie::SE3>& poses = mapper_.graph().poses();
   const std::size_t count = std::min(options_.snapshot_keyframes, poses.size());
   GraphSnapshot snapshot{
-      .keyframe = id,
-      .poses_T_map_body = std::vector<lie::SE3>(poses.end() - count, poses.end())};
+      .keyframe = id, .poses_T_map_body = std::vector<lie::SE3>(poses.end() - count, poses.end())};
   {
     const std::lock_guard lock(mutex_);
     snapshots_.push_back(std::move(snapshot));

@@ -57,7 +57,8 @@ void PoseGraph::setEnuMap(const lie::SE3& T_enu_map) {
 
 void PoseGraph::addGnss(const GnssObservation& observation) {
   if (!T_enu_map_) throw std::logic_error("PoseGraph::addGnss before setEnuMap");
-  if (observation.keyframe >= size()) throw std::logic_error("PoseGraph::addGnss: no such keyframe");
+  if (observation.keyframe >= size())
+    throw std::logic_error("PoseGraph::addGnss: no such keyframe");
   gnss_.push_back(observation);
   unsolved_ = true;
 }
@@ -98,8 +99,7 @@ double PoseGraph::optimize() {
   if (size() < 2) return 0.0;
   std::vector<PoseBlock> blocks;
   blocks.reserve(size());
-  for (const lie::SE3& pose : poses_)
-    backend::writePoseBlock(pose, blocks.emplace_back().data());
+  for (const lie::SE3& pose : poses_) backend::writePoseBlock(pose, blocks.emplace_back().data());
 
   // The problem owns the factors and the loss functions; the manifold is shared.
   ceres::Problem::Options problem_options;
@@ -118,8 +118,8 @@ double PoseGraph::optimize() {
   for (const Position& position : positions_) {
     ceres::LossFunction* loss =
         position.huber_sigmas > 0.0 ? new ceres::HuberLoss(position.huber_sigmas) : nullptr;
-    problem.AddResidualBlock(new backend::PositionFactor(position.p_map, position.covariance),
-                             loss, blocks[position.keyframe].data());
+    problem.AddResidualBlock(new backend::PositionFactor(position.p_map, position.covariance), loss,
+                             blocks[position.keyframe].data());
   }
   // The ENU block is free in yaw and translation; see the header for the gauge.
   std::array<double, backend::kEnuWorldSize> enu{};

@@ -48,8 +48,9 @@ void ImuPrior::addImu(const ImuSample& sample) {
 bool ImuPrior::start(const io::Scan& scan, std::optional<FirstScan>& first) {
   if (smoother_.initialized()) return true;
   if (imu_.empty() || imu_.lastTime() - imu_.firstTime() < kInitializationWindow_s) {
-    logger().debug("scan {} at {:.3f} s skipped: waiting for {:.1f} s of IMU readings to initialize",
-                   scan.index, scan.t_end_s, kInitializationWindow_s);
+    logger().debug(
+        "scan {} at {:.3f} s skipped: waiting for {:.1f} s of IMU readings to initialize",
+        scan.index, scan.t_end_s, kInitializationWindow_s);
     return false;
   }
   if (!first_scan_) {
@@ -73,16 +74,15 @@ MotionPrediction ImuPrior::predict(const io::Scan& scan) {
   const backend::StateEstimate previous = smoother_.latest();
   MotionPrediction prediction;
   // The preintegrated increment predicts the pose at the scan's end (and is the IMU factor).
-  preintegrated_.emplace(
-      imu_.preintegrate(previous.t_s, scan.t_end_s, previous.bias, config_.imu));
+  preintegrated_.emplace(imu_.preintegrate(previous.t_s, scan.t_end_s, previous.bias, config_.imu));
   predicted_t_s_ = scan.t_end_s;
   prediction.T_odom_body =
       poseOf(preintegrated_->predict(previous.state, previous.bias, gravity_odom_));
   // Propagation at IMU rate over the sweep (from its start when it began before the state).
   const double t_from_s = std::min(previous.t_s, scan.t_start_s);
-  const auto states = imu::propagateThrough(previous.state, previous.t_s, scan.t_end_s,
-                                            imu_.between(t_from_s, scan.t_end_s), previous.bias,
-                                            gravity_odom_);
+  const auto states =
+      imu::propagateThrough(previous.state, previous.t_s, scan.t_end_s,
+                            imu_.between(t_from_s, scan.t_end_s), previous.bias, gravity_odom_);
   for (std::size_t k = 1; k < states.size(); ++k)
     prediction.imu_rate_poses.push_back({states[k].t_s, poseOf(states[k].state)});
   prediction.sweep_T_odom_body = imu::toTrajectory(states);

@@ -99,8 +99,7 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
   return out;
 }
 
-std::optional<lie::SE3> ImuPrior::collectForAlignment(double t_s,
-                                                      const lie::SE3& T_unlevelled_body,
+std::optional<lie::SE3> ImuPrior::collectForAlignment(double t_s, const lie::SE3& T_unlevelled_body,
                                                       const imu::Preintegrator* increment) {
   alignment_times_.push_back(t_s);
   alignment_poses_.push_back(T_unlevelled_body);

@@ -38,9 +38,9 @@ LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
   if (!r.converged || r.hessian_condition > config.degenerate_condition) {
     inflation = 10.0;
     verdict.factor = LidarFactor::kInflated;
-    verdict.note = !r.converged ? "registration hit its iteration limit"
-                                : fmt::format("degenerate: Hessian condition {:.3g}",
-                                              r.hessian_condition);
+    verdict.note = !r.converged
+                       ? "registration hit its iteration limit"
+                       : fmt::format("degenerate: Hessian condition {:.3g}", r.hessian_condition);
   }
   // Roll and pitch keep sigma_sm: gravity in the IMU factor observes them, and a tighter lidar
   // factor would hold on to a tilted local map. Heading has no such second source, so it gets its

@@ -72,8 +72,9 @@ void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
   registrations_since_keyframe_ = 0;
 }
 
-void LocalMap::repose(const std::function<lie::SE3(std::uint64_t id, const lie::SE3& T_odom_keyframe)>&
-                          T_odom_keyframe_at) {
+void LocalMap::repose(
+    const std::function<lie::SE3(std::uint64_t id, const lie::SE3& T_odom_keyframe)>&
+        T_odom_keyframe_at) {
   finishPendingBuild();
   for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
   point_statistics_.clear();

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "scan_preparation.hpp"
 #include "taiga/backend/odometry_smoother.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/core/point_cloud.hpp"
@@ -24,13 +25,12 @@
 #include "taiga/imu/preintegration.hpp"
 #include "taiga/io/recording.hpp"
 #include "taiga/registration/registration.hpp"
-#include "scan_preparation.hpp"
 
 namespace taiga::pipeline {
 
 struct MotionPrediction {
-  lie::SE3 T_odom_body;            ///< at the scan's end
-  Trajectory sweep_T_odom_body;    ///< poses covering the sweep, for deskewing
+  lie::SE3 T_odom_body;          ///< at the scan's end
+  Trajectory sweep_T_odom_body;  ///< poses covering the sweep, for deskewing
   /// Propagated IMU-rate poses after the previous state up to the scan's end (IMU only).
   std::vector<StampedPose> imu_rate_poses;
 };

@@ -49,8 +49,7 @@ class OdometryCorrection {
   void addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe);
   /// Takes the graph's snapshot: updates T_map_odom and, when the graph bent the local map's
   /// keyframes, rebuilds the odometry's local map. Returns whether it did.
-  bool apply(const mapping::GraphSnapshot& snapshot, bool keep_gravity,
-             Odometry& odometry);
+  bool apply(const mapping::GraphSnapshot& snapshot, bool keep_gravity, Odometry& odometry);
 
  private:
   struct LocalMapKeyframe {

@@ -104,8 +104,7 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
   std::vector<double> latencies_ms;
   while (std::optional<RecordingFeed::Delivery> delivery = feed.next()) {
     read_ms_since_scan += delivery->read_ms;
-    if (handle(delivery->event))
-      latencies_ms.push_back(1000.0 * secondsSince(delivery->delivered));
+    if (handle(delivery->event)) latencies_ms.push_back(1000.0 * secondsSince(delivery->delivered));
   }
   progress.finish();
   if (options.realtime)
@@ -137,8 +136,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
 
   RunSummary summary;
   const auto wall_start = Clock::now();
-  summary.scans = feedRecording(recording, std::move(read_ahead), options, slam, scan_log,
-                                summary.realtime);
+  summary.scans =
+      feedRecording(recording, std::move(read_ahead), options, slam, scan_log, summary.realtime);
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);
@@ -161,10 +160,11 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   summary.map_export_s = secondsSince(export_start);
   gnss.writeOnline(out / "georef");
   if (!gnss.input().fixes.empty())
-    summary.georef = georeferenceRun(
-        corrected, gnss.input(), config, recording_path.string(),
-        {.store = slam.keyframes(), .poses_T_map_body = keyframe_poses, .voxel_m = options.map_voxel_m},
-        out);
+    summary.georef = georeferenceRun(corrected, gnss.input(), config, recording_path.string(),
+                                     {.store = slam.keyframes(),
+                                      .poses_T_map_body = keyframe_poses,
+                                      .voxel_m = options.map_voxel_m},
+                                     out);
 
   summary.loop_closures = mapper.loopClosures();
   summary.odometry_correction_wait_s = slam.correctionWait_s();

@@ -23,8 +23,8 @@ GeorefRunReport georeferenceRun(const Trajectory& trajectory, const georef::Gnss
   report.epsg = config.georef.epsg;
   georef::Georeference result;
   try {
-    result = georef::georeference(trajectory, gnss, georef::settingsFrom(config.georef),
-                                  config.rig, "trajectory.tum", recording_name);
+    result = georef::georeference(trajectory, gnss, georef::settingsFrom(config.georef), config.rig,
+                                  "trajectory.tum", recording_name);
   } catch (const InputError& e) {
     report.skipped = e.what();
     logger().warn("not georeferenced: {}", report.skipped);
@@ -50,11 +50,11 @@ GeorefRunReport georeferenceRun(const Trajectory& trajectory, const georef::Gnss
                      dir / fmt::format("map_epsg{}.las", report.epsg), options);
   report.map_export_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - export_start).count();
-  logger().info("georeferenced ({}): {} of {} fixes, residual RMS {:.2f} m horizontal, 1-sigma "
-                "{:.2f} m east {:.2f} m north {:.2f} deg yaw; {}",
-                report.method, report.inliers, report.fixes, report.horizontal_rms_m,
-                report.sigma[0], report.sigma[1], report.sigma[5] * kDegPerRad,
-                dir.string());
+  logger().info(
+      "georeferenced ({}): {} of {} fixes, residual RMS {:.2f} m horizontal, 1-sigma "
+      "{:.2f} m east {:.2f} m north {:.2f} deg yaw; {}",
+      report.method, report.inliers, report.fixes, report.horizontal_rms_m, report.sigma[0],
+      report.sigma[1], report.sigma[5] * kDegPerRad, dir.string());
   return report;
 }
 

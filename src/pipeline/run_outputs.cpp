@@ -77,8 +77,8 @@ void ScanLog::onScan(const ScanOutcome& scan, const lie::SE3& /*T_map_odom*/) {
   const registration::RegistrationResult& r = scan.registration;
   scans_ << fmt::format("{:.6f},{},{},{:.5f},{},{},{},{:.4g},{},{},\"{}\"\n", scan.t_s,
                         scan.scan_index, lidarFactorName(scan.lidar), r.fitness_m2, r.iterations,
-                        r.converged ? 1 : 0, r.num_inliers, r.hessian_condition,
-                        scan.source_points, scan.keyframe_id ? 1 : 0, scan.lidar_note);
+                        r.converged ? 1 : 0, r.num_inliers, r.hessian_condition, scan.source_points,
+                        scan.keyframe_id ? 1 : 0, scan.lidar_note);
 }
 
 void ScanLog::onKeyframe(std::uint64_t /*id*/, const ScanOutcome& /*scan*/) { ++keyframes_; }

@@ -63,7 +63,8 @@ class ScanLog final : public SlamObserver {
 std::ofstream openOutput(const std::filesystem::path& path);
 
 /// loops.csv: every loop closure attempt, accepted or not, and why.
-void writeLoops(const std::filesystem::path& path, const std::vector<mapping::LoopRecord>& attempts);
+void writeLoops(const std::filesystem::path& path,
+                const std::vector<mapping::LoopRecord>& attempts);
 
 /// summary.json.
 void writeSummary(const std::filesystem::path& path, const RunSummary& summary,

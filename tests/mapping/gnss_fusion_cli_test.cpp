@@ -35,8 +35,8 @@ TEST(GnssFusionCli, TaigaRunFusesTheFixesAndReportsTheMapToEnuTransform) {
   const auto overrides = dir.write("exact.yaml", "gnss: {noise: false, world_yaw_deg: 30}\n");
   const auto sim = dir.file("sim");
   ASSERT_EQ(runTaiga("simulate --scenario handheld-loop --duration 30 --beams 16 --columns 512 "
-                     "--sub-rays 1 --seed 5 --overrides " + overrides.string() + " --out " +
-                     sim.string())
+                     "--sub-rays 1 --seed 5 --overrides " +
+                     overrides.string() + " --out " + sim.string())
                 .exit_code,
             0);
   std::string rig = readText(sim / "rig.yaml");
@@ -51,8 +51,8 @@ TEST(GnssFusionCli, TaigaRunFusesTheFixesAndReportsTheMapToEnuTransform) {
 
   auto runInto = [&](const std::string& name) {
     const auto out = dir.file(name);
-    const test::TaigaResult r = runTaiga("run " + (sim / "recording.bag").string() +
-                                         " --config " + config.string() + " --out " + out.string());
+    const test::TaigaResult r = runTaiga("run " + (sim / "recording.bag").string() + " --config " +
+                                         config.string() + " --out " + out.string());
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return out;
   };
@@ -75,8 +75,8 @@ TEST(GnssFusionCli, TaigaRunFusesTheFixesAndReportsTheMapToEnuTransform) {
   const geo::Geodetic sim_origin{61.0, 24.5, 120.0};  // the handheld-loop scenario's
   const double world_yaw_rad = 30.0 * kRadPerDeg;
   Eigen::Matrix3d R_enu_simworld;
-  R_enu_simworld << std::cos(world_yaw_rad), -std::sin(world_yaw_rad), 0,
-      std::sin(world_yaw_rad), std::cos(world_yaw_rad), 0, 0, 0, 1;
+  R_enu_simworld << std::cos(world_yaw_rad), -std::sin(world_yaw_rad), 0, std::sin(world_yaw_rad),
+      std::cos(world_yaw_rad), 0, 0, 0, 1;
   const geo::CoordinateConverter converter;
   const Trajectory truth = io::readTum(sim / "groundtruth.tum");
   const Trajectory estimate = io::readTum(run / "trajectory.tum");
@@ -88,8 +88,7 @@ TEST(GnssFusionCli, TaigaRunFusesTheFixesAndReportsTheMapToEnuTransform) {
     const Eigen::Vector3d p_truth = converter.toEnu(
         fusion_origin,
         converter.fromEnu(sim_origin, R_enu_simworld * T_simworld_body->translation()));
-    const Eigen::Vector3d p_fused =
-        (T_enu_map * pose.pose.translation().homogeneous()).head<3>();
+    const Eigen::Vector3d p_fused = (T_enu_map * pose.pose.translation().homogeneous()).head<3>();
     worst_horizontal_m = std::max(worst_horizontal_m, (p_fused - p_truth).head<2>().norm());
     sum_squared_m2 += (p_fused - p_truth).squaredNorm();
     ++compared;

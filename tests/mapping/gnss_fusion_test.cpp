@@ -3,6 +3,8 @@
 // find T_enu_map within the noise, pull the drifted map back onto the truth, shrug off a
 // multipath burst (and only because of its robust kernel), wait until the heading is observable,
 // and give the same answer whether it runs inline or on the mapping thread.
+#include "taiga/mapping/gnss_fusion.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +16,6 @@
 #include "taiga/core/angles.hpp"
 #include "taiga/geo/coordinates.hpp"
 #include "taiga/georef/fit.hpp"
-#include "taiga/mapping/gnss_fusion.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/mapping/mapper.hpp"
 
@@ -72,9 +73,9 @@ std::vector<GnssFix> fixesFor(const std::vector<lie::SE3>& truth, const FixNoise
   for (std::size_t k = 0; k + 1 < truth.size(); ++k) {
     const Eigen::Vector3d p_world = lie::interpolate(truth[k], truth[k + 1], 0.5).translation();
     Eigen::Vector3d p_enu = kTrueEnuWorld * p_world;
-    p_enu += Eigen::Vector3d(noise.sigma_horizontal_m * gauss(rng),
-                             noise.sigma_horizontal_m * gauss(rng),
-                             noise.sigma_vertical_m * gauss(rng));
+    p_enu +=
+        Eigen::Vector3d(noise.sigma_horizontal_m * gauss(rng),
+                        noise.sigma_horizontal_m * gauss(rng), noise.sigma_vertical_m * gauss(rng));
     const std::size_t i = fixes.size();
     if (i >= noise.burst_begin && i < noise.burst_end) p_enu += noise.burst_m;
     const geo::Geodetic where = converter.fromEnu(kOrigin, p_enu);
@@ -84,8 +85,8 @@ std::vector<GnssFix> fixesFor(const std::vector<lie::SE3>& truth, const FixNoise
     fix.longitude_deg = where.longitude_deg;
     fix.height_ellipsoid_m = where.height_m;
     fix.covariance_enu_m2 =
-        Eigen::Vector3d(std::pow(noise.sigma_horizontal_m, 2), std::pow(noise.sigma_horizontal_m, 2),
-                        std::pow(noise.sigma_vertical_m, 2))
+        Eigen::Vector3d(std::pow(noise.sigma_horizontal_m, 2),
+                        std::pow(noise.sigma_horizontal_m, 2), std::pow(noise.sigma_vertical_m, 2))
             .asDiagonal();
     fix.covariance_type = GnssCovarianceType::kDiagonalKnown;
     fix.status = GnssStatus::kFix;
@@ -243,7 +244,7 @@ TEST(GnssFusion, WaitsUntilTheHeadingIsObservableAndGatesPoorFixes) {
   const std::vector<lie::SE3> truth = trueRectangle();
   const std::vector<lie::SE3> odometry = driftingOdometry(truth);
   std::vector<GnssFix> fixes = fixesFor(truth, {}, 3);
-  fixes[0].status = GnssStatus::kNoFix;                      // no fix
+  fixes[0].status = GnssStatus::kNoFix;                            // no fix
   fixes[1].covariance_enu_m2 = Eigen::Matrix3d::Identity() * 100;  // 10 m > 5 m
   const MappingConfig config = fusionConfig();
 
@@ -258,7 +259,8 @@ TEST(GnssFusion, WaitsUntilTheHeadingIsObservableAndGatesPoorFixes) {
 
   // 16 keyframes (15 m): fusion starts, with every fix attached so far.
   const std::vector<lie::SE3> longer(odometry.begin(), odometry.begin() + 16);
-  const Fused started = fuse(config, longer, std::vector<GnssFix>(fixes.begin(), fixes.begin() + 18));
+  const Fused started =
+      fuse(config, longer, std::vector<GnssFix>(fixes.begin(), fixes.begin() + 18));
   EXPECT_TRUE(started.report.T_enu_map.has_value());
   EXPECT_EQ(started.report.used, 13u);    // fixes 2..14 lie between keyframes 0 and 15
   EXPECT_EQ(started.report.outside, 3u);  // fixes 15..17 come after the last keyframe

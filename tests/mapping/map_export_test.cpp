@@ -63,7 +63,8 @@ TEST(MapExport, EveryPointLandsInTheWorldWithItsTimeIntensityRingAndKeyframe) {
     const PointCloud body = wallInBody(k, 100.0 + k);
     for (std::size_t i = 0; i < body.size(); ++i) {
       const std::size_t m = 50 * k + i;
-      EXPECT_LT((map.positions[m] - poseOf(k) * body.positions[i]).cwiseAbs().maxCoeff(), 0.0005 + 1e-9);
+      EXPECT_LT((map.positions[m] - poseOf(k) * body.positions[i]).cwiseAbs().maxCoeff(),
+                0.0005 + 1e-9);
       EXPECT_EQ(map.times_s[m], body.times_s[i]);
       EXPECT_EQ(map.intensities[m], body.intensities[i]);
       EXPECT_EQ(map.rings[m], body.rings[i]);

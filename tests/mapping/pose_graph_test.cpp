@@ -1,13 +1,14 @@
 // The mapping graph on a synthetic 160 m loop whose odometry drifts in heading: one loop factor
 // must pull the end back onto the start and spread the correction along the loop, and a false
 // loop must be refused by the consistency check without touching the poses.
+#include "taiga/mapping/pose_graph.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
 #include "taiga/core/angles.hpp"
-#include "taiga/mapping/pose_graph.hpp"
 
 namespace taiga::mapping {
 namespace {
@@ -19,7 +20,8 @@ std::vector<lie::SE3> trueSquareLoop() {
   for (int k = 0; k < 160; ++k) {
     poses.push_back(T_world_body);
     const double yaw_step = (k % 40 == 39) ? 90.0 * kRadPerDeg : 0.0;
-    T_world_body = T_world_body * lie::SE3::Exp((lie::Vector6() << 1, 0, 0, 0, 0, yaw_step).finished());
+    T_world_body =
+        T_world_body * lie::SE3::Exp((lie::Vector6() << 1, 0, 0, 0, 0, yaw_step).finished());
   }
   return poses;
 }

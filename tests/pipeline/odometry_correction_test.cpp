@@ -11,7 +11,8 @@ namespace taiga::pipeline {
 namespace {
 
 lie::SE3 poseAt(double x_m, double yaw_rad) {
-  return lie::SE3(lie::SO3::fromRollPitchYaw(0.0, 0.0, yaw_rad), Eigen::Vector3d(x_m, 0.5 * x_m, 0.0));
+  return lie::SE3(lie::SO3::fromRollPitchYaw(0.0, 0.0, yaw_rad),
+                  Eigen::Vector3d(x_m, 0.5 * x_m, 0.0));
 }
 
 struct Fixture {
@@ -38,22 +39,26 @@ struct Fixture {
 TEST(OdometryCorrection, ARigidCorrectionMovesOnlyTheMapToOdomTransform) {
   Fixture f(6);
   EXPECT_TRUE(f.correction.T_map_odom().matrix().isIdentity());
-  const lie::SE3 T_map_odom(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.1), Eigen::Vector3d(0.3, -0.2, 0.05));
+  const lie::SE3 T_map_odom(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.1),
+                            Eigen::Vector3d(0.3, -0.2, 0.05));
   const bool rebuilt = f.correction.apply(f.snapshot(3, 4, [&](std::size_t) { return T_map_odom; }),
                                           /*keep_gravity=*/false, f.odometry);
   EXPECT_FALSE(rebuilt);
   EXPECT_TRUE(f.correction.T_map_odom().matrix().isApprox(T_map_odom.matrix(), 1e-12));
 }
 
-TEST(OdometryCorrection, WithAnImuTheCorrectionIsATurnAboutZThatKeepsTheKeyframeWhereTheGraphHasIt) {
+TEST(OdometryCorrection,
+     WithAnImuTheCorrectionIsATurnAboutZThatKeepsTheKeyframeWhereTheGraphHasIt) {
   Fixture f(6);
   // A correction with some tilt, as a graph without gravity could give.
-  const lie::SE3 T_map_odom(lie::SO3::fromRollPitchYaw(0.02, -0.01, 0.1), Eigen::Vector3d(0.3, -0.2, 0.05));
+  const lie::SE3 T_map_odom(lie::SO3::fromRollPitchYaw(0.02, -0.01, 0.1),
+                            Eigen::Vector3d(0.3, -0.2, 0.05));
   f.correction.apply(f.snapshot(3, 4, [&](std::size_t) { return T_map_odom; }),
                      /*keep_gravity=*/true, f.odometry);
   const lie::SE3& corrected = f.correction.T_map_odom();
   const Eigen::Vector3d z_odom_in_map = corrected.rotation() * Eigen::Vector3d::UnitZ();
-  EXPECT_NEAR(z_odom_in_map.z(), 1.0, 1e-12);  // no tilt: the published roll and pitch stay the IMU's
+  EXPECT_NEAR(z_odom_in_map.z(), 1.0,
+              1e-12);  // no tilt: the published roll and pitch stay the IMU's
   EXPECT_NEAR(corrected.rotation().yaw(), T_map_odom.rotation().yaw(), 1e-12);
   // Keyframe 3's position goes where the graph has it.
   const Eigen::Vector3d p_odom_3 = f.T_odom_keyframes[3].translation();

@@ -38,8 +38,8 @@ struct EventLog final : SlamObserver {
   void onGnssFix(const GnssFix& fix) override { entries.push_back({"fix", fix.t_s, 0, {}}); }
   void onImu(const ImuSample&) override { ++imu_samples; }
   std::size_t count(const std::string& kind) const {
-    return static_cast<std::size_t>(
-        std::count_if(entries.begin(), entries.end(), [&](const Entry& e) { return e.kind == kind; }));
+    return static_cast<std::size_t>(std::count_if(entries.begin(), entries.end(),
+                                                  [&](const Entry& e) { return e.kind == kind; }));
   }
 };
 
@@ -62,7 +62,10 @@ io::Scan scanAt(const std::vector<Eigen::Vector3d>& forest_in_world, std::uint64
 }
 
 GnssFix fixAt(double t_s) {
-  return {.t_s = t_s, .latitude_deg = 60.2, .longitude_deg = 24.9, .height_ellipsoid_m = 30.0,
+  return {.t_s = t_s,
+          .latitude_deg = 60.2,
+          .longitude_deg = 24.9,
+          .height_ellipsoid_m = 30.0,
           .status = GnssStatus::kFix};
 }
 
@@ -75,7 +78,8 @@ SystemConfig lidarOnlyConfig() {
 TEST(SlamSystem, LidarOnlyPublishesEveryScanOnceInOrderAndFollowsTheWalk) {
   const test::TempDir dir;
   const std::vector<Eigen::Vector3d> trees = forestInWorld(3);
-  SlamSystem slam(lidarOnlyConfig(), {.keyframe_dir = dir.path() / "keyframes", .lidar_only = true});
+  SlamSystem slam(lidarOnlyConfig(),
+                  {.keyframe_dir = dir.path() / "keyframes", .lidar_only = true});
   EventLog log;
   slam.addObserver(log);
   // 3 s at 1 m/s along x, turning slowly; a GNSS fix every second.
@@ -132,7 +136,8 @@ TEST(SlamSystem, WithAnImuNothingIsPublishedBeforeTheOdomFrameIsLevelled) {
   slam.addObserver(log);
   // A rig standing still and level: the IMU at 200 Hz reads gravity's reaction.
   const lie::SE3 T_world_body = forest::poseAt(0.0, 0.0, 1.5, 0.3);
-  ImuSample still{.acceleration_imu_mps2 = Eigen::Vector3d(0.0, 0.0, config.odometry.imu.gravity_mps2)};
+  ImuSample still{.acceleration_imu_mps2 =
+                      Eigen::Vector3d(0.0, 0.0, config.odometry.imu.gravity_mps2)};
   std::vector<std::size_t> published_after_scan;
   std::uint64_t scan_index = 0;
   for (int i = 0; i <= 800; ++i) {  // 4 s

@@ -9,9 +9,9 @@
 // keyframe (as PDAL's filters.voxelcenternearestneighbor). Unlike a per-keyframe filter, a tree
 // seen from 50 keyframes is not kept 50 times. Ties go to the earlier keyframe, so the result does
 // not depend on anything but the store and the poses. Memory: about 170 B per output point (a
-// hash-map entry and a record per occupied voxel); the full-resolution scans are streamed (one keyframe in RAM at a
-// time). Without decimation nothing but one keyframe is held, except for map.ply, which is
-// written at the end from the whole map in RAM (as io::writePly needs).
+// hash-map entry and a record per occupied voxel); the full-resolution scans are streamed (one
+// keyframe in RAM at a time). Without decimation nothing but one keyframe is held, except for
+// map.ply, which is written at the end from the whole map in RAM (as io::writePly needs).
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -25,7 +25,7 @@
 namespace taiga::mapping {
 
 struct MapExportOptions {
-  double voxel_m = 0.0;  ///< > 0: one point per voxel of this edge, m (`--map-voxel`)
+  double voxel_m = 0.0;    ///< > 0: one point per voxel of this edge, m (`--map-voxel`)
   bool write_ply = false;  ///< also the same points as binary PLY (las path with .ply)
   /// Output frame: p_out = T_out_map * T_map_body * p_body; affine, so that it can carry a
   /// projected grid's scale factor (e.g. a georeferencing's T_epsg_world; identity: the map in

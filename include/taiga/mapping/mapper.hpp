@@ -82,7 +82,7 @@ class Mapper {
 /// The mapping graph's poses of the newest keyframes right after it handled one keyframe: what
 /// the odometry rebuilds its local map from (MappingConfig::correct_odometry).
 struct GraphSnapshot {
-  std::size_t keyframe = 0;                  ///< the keyframe just handled, the last of the poses
+  std::size_t keyframe = 0;                ///< the keyframe just handled, the last of the poses
   std::vector<lie::SE3> poses_T_map_body;  ///< keyframes keyframe - size + 1 ... keyframe
 };
 

@@ -102,8 +102,9 @@ class Odometry {
   /// Moves the local map's keyframes to `T_odom_keyframe_at(id, T_odom_keyframe)` and
   /// rebuilds it, e.g. in the shape the mapping graph gave them after a loop closure
   /// (MappingConfig::correct_odometry). The state stays. Between scans.
-  void reposeLocalMap(const std::function<lie::SE3(std::uint64_t id, const lie::SE3& T_odom_keyframe)>&
-                          T_odom_keyframe_at) {
+  void reposeLocalMap(
+      const std::function<lie::SE3(std::uint64_t id, const lie::SE3& T_odom_keyframe)>&
+          T_odom_keyframe_at) {
     local_map_.repose(T_odom_keyframe_at);
   }
   const std::string& initializationNote() const;
