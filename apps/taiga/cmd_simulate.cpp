@@ -9,6 +9,7 @@
 #include "command.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/progress.hpp"
+#include "taiga/sim/realism.hpp"
 #include "taiga/sim/reference_cloud.hpp"
 #include "taiga/sim/scenario_yaml.hpp"
 #include "taiga/sim/simulator.hpp"
@@ -17,6 +18,7 @@ namespace taiga::app {
 namespace {
 struct SimulateOptions {
   std::string scenario = "mixed";
+  std::string realism = "ideal";       // preset of the errors the rig.yaml does not state
   std::string overrides;               // YAML file overriding scenario fields
   std::optional<double> duration_s;    // default: the scenario's duration_s
   std::uint64_t seed = 1;
@@ -29,8 +31,9 @@ struct SimulateOptions {
 };
 
 int runSimulate(const SimulateOptions& options) {
-  // Precedence: the named scenario, then the overrides file, then the command line.
+  // Precedence: the named scenario, the realism preset, the overrides file, the command line.
   sim::Scenario scenario = sim::scenarioByName(options.scenario);
+  sim::applyRealism(options.realism, scenario);
   if (!options.overrides.empty()) sim::applyScenarioOverrides(options.overrides, scenario);
   if (options.beams) scenario.lidar.beams = *options.beams;
   if (options.columns) scenario.lidar.columns = *options.columns;
@@ -88,6 +91,13 @@ Command addSimulateCommand(CLI::App& tool) {
                    "Forest, rig and motion scenario: " + names +
                        " (hyphens and underscores are interchangeable)")
       ->capture_default_str();
+  parser
+      ->add_option("--realism", options->realism,
+                   "Errors of the rig that its rig.yaml does not state (IMU noise and biases, "
+                   "extrinsics, time offset, lidar noise, lost packets, wind): ideal, typical, "
+                   "harsh; the truth goes to rig_truth.yaml (docs/simulator.md, \"Realism\")")
+      ->capture_default_str()
+      ->check(CLI::IsMember(sim::realismNames()));
   parser->add_option("--overrides", options->overrides,
                      "YAML file overriding scenario fields (forest:, motion:, lidar:, imu:, gnss:; "
                      "see docs/simulator.md); a recording's scenario.yaml reproduces it");

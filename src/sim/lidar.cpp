@@ -14,16 +14,18 @@
 
 #include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
-#include "taiga/core/log.hpp"
 #include "taiga/io/ouster/sensor_info.hpp"
 #include "taiga/sim/machine.hpp"
 #include "ring_on_curve.hpp"
 #include "taiga/sim/random.hpp"
+#include "taiga/sim/sensor_models.hpp"
 
 namespace taiga::sim {
 namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr int kMaxSubRays = 8;
+/// Columns per lidar UDP packet (Ouster: 16), the unit of packet loss.
+constexpr int kColumnsPerPacket = 16;
 /// Range of a ray that hit nothing.
 constexpr double kNoHit = std::numeric_limits<double>::infinity();
 /// Reflectivity of the target that reaches max_range_m at normal incidence.
@@ -64,46 +66,37 @@ LidarGeometry loadLidarGeometry(const LidarParams& params) {
     throw InputError(fmt::format("lidar.beams: expected at least 1, found {}", params.beams));
   if (params.columns < 16)
     throw InputError(fmt::format("lidar.columns: expected at least 16, found {}", params.columns));
-  LidarGeometry g;
-  if (!params.metadata_json.empty() && std::filesystem::exists(params.metadata_json)) {
+  LidarGeometry full;
+  if (params.metadata_json.empty()) {
+    full = sensorModel(params.model);
+  } else {
+    if (!std::filesystem::exists(params.metadata_json))
+      throw InputError(fmt::format("lidar.metadata_json: {}: no such file", params.metadata_json));
     const io::ouster::SensorInfo info = io::ouster::readSensorInfo(params.metadata_json);
-    const auto n = static_cast<int>(info.beam_altitude_angles_deg.size());
-    if (params.beams > n) {
-      throw InputError(fmt::format("{}: has {} beams, {} were asked for", params.metadata_json, n,
-                                   params.beams));
-    }
-    for (int i = 0; i < params.beams; ++i) {
-      // Evenly subsample: a 128-beam table gives a 64- or 32-beam head of the same field of view.
-      const int row = params.beams == 1
-                          ? n / 2
-                          : static_cast<int>(std::lround(i * (n - 1.0) / (params.beams - 1.0)));
-      g.beam_altitude_deg.push_back(info.beam_altitude_angles_deg[row]);
-      g.beam_azimuth_deg.push_back(
-          info.beam_azimuth_angles_deg.empty() ? 0.0 : info.beam_azimuth_angles_deg[row]);
-    }
-    g.lidar_origin_to_beam_origin_m = info.lidar_origin_to_beam_origin_mm / 1000.0;
-    g.beam_origin_z_m = info.T_lidar_beam.translation().z();
-    g.T_sensor_lidar = info.T_sensor_lidar;
-    g.T_sensor_imu = info.T_sensor_imu;
-    g.source = params.metadata_json;
-    return g;
+    full.beam_altitude_deg = info.beam_altitude_angles_deg;
+    full.beam_azimuth_deg = info.beam_azimuth_angles_deg;
+    full.beam_azimuth_deg.resize(full.beam_altitude_deg.size(), 0.0);
+    full.lidar_origin_to_beam_origin_m = info.lidar_origin_to_beam_origin_mm / 1000.0;
+    full.beam_origin_z_m = info.T_lidar_beam.translation().z();
+    full.T_sensor_lidar = info.T_sensor_lidar;
+    full.T_sensor_imu = info.T_sensor_imu;
+    full.source = params.metadata_json;
   }
-  logger().warn(
-      "{}: not found; the simulated lidar uses {} beams spread uniformly over {} deg",
-      params.metadata_json.empty() ? std::string("(no metadata file)") : params.metadata_json,
-      params.beams, params.fallback_vertical_fov_deg);
+  const auto n = static_cast<int>(full.beam_altitude_deg.size());
+  if (params.beams > n)
+    throw InputError(fmt::format("lidar.beams: {} has {} beams, {} were asked for", full.source,
+                                 n, params.beams));
+  // Evenly subsample: a 128-beam table gives a 64- or 32-beam head of the same field of view.
+  LidarGeometry g = full;
+  g.beam_altitude_deg.clear();
+  g.beam_azimuth_deg.clear();
   for (int i = 0; i < params.beams; ++i) {
-    const double f = params.beams == 1 ? 0.5 : static_cast<double>(i) / (params.beams - 1);
-    g.beam_altitude_deg.push_back(params.fallback_vertical_fov_deg * (0.5 - f));
-    g.beam_azimuth_deg.push_back(0.0);
+    const int row = params.beams == 1
+                        ? n / 2
+                        : static_cast<int>(std::lround(i * (n - 1.0) / (params.beams - 1.0)));
+    g.beam_altitude_deg.push_back(full.beam_altitude_deg[row]);
+    g.beam_azimuth_deg.push_back(full.beam_azimuth_deg[row]);
   }
-  // OS0 frames as in its metadata: lidar frame turned 180 deg about z, 36.18 mm above the sensor
-  // frame's origin; the IMU offset by (6.253, -11.775, 7.645) mm.
-  g.T_sensor_lidar = lie::SE3(lie::SO3::fromAxisAngle(Eigen::Vector3d::UnitZ(), kPi),
-                              Eigen::Vector3d(0, 0, 0.03618));
-  g.T_sensor_imu = lie::SE3(lie::SO3(), Eigen::Vector3d(0.006253, -0.011775, 0.007645));
-  g.lidar_origin_to_beam_origin_m = 0.015806;
-  g.source = "uniform fallback";
   return g;
 }
 
@@ -160,6 +153,10 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
   std::vector<SubHit> centers(pixels.size(), SubHit{kNoHit, 0.0, 0.0});
   std::vector<std::uint8_t> solid(pixels.size(), 0);
   std::vector<std::int32_t> segment(pixels.size(), -1);  ///< curve segment of the centre hit
+  // Wind: the sway gain of each centre hit (0: does not move), only when there is wind.
+  const Wind& wind_field = scene.wind();
+  const bool wind = !wind_field.calm();
+  std::vector<float> sway_gain(wind ? pixels.size() : 0, 0.0f);
   auto direction = [&](int col, int row) -> const Eigen::Vector3d& {
     return directions_lidar_[static_cast<std::size_t>(col) * rows + row];
   };
@@ -194,6 +191,11 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
             centers[pixel] = {hit->range_m, 1.0, reflectivity(hit->material) * cos_inc};
             solid[pixel] = hit->material != Material::kFoliage ? 1 : 0;
             segment[pixel] = hit->curve_segment;
+            if (wind) {
+              const Eigen::Vector3d p = c.origin_world + hit->range_m * dirs[row];
+              sway_gain[pixel] = static_cast<float>(Wind::gain(
+                  hit->material, p.z() - scene.terrain().smoothHeight(p.x(), p.y())));
+            }
           }
         }
       });
@@ -394,17 +396,38 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
           if (hashUniform(seed_, index, pixel_id, 102) <
               std::max(params_.dropout_probability, edge))
             continue;
-          r += (params_.range_noise_m + params_.range_noise_per_m * r) *
-               hashNormal(seed_, index, pixel_id, 103);
+          double sigma_m = params_.range_noise_m + params_.range_noise_per_m * r;
+          if (params_.range_noise_at_limit_m > 0.0)  // weak returns: SNR falls as (r / r_max)^2
+            sigma_m += params_.range_noise_at_limit_m * (r / r_max) * (r / r_max);
+          r += sigma_m * hashNormal(seed_, index, pixel_id, 103);
         }
         Pixel& px = pixels[pixel_id];
         px.valid = true;
-        const Eigen::Vector3d p_lidar = c.origin_lidar + r * d_lidar;
+        Eigen::Vector3d p_lidar = c.origin_lidar + r * d_lidar;
+        if (wind && sway_gain[pixel_id] > 0.0f) {  // the surface has moved with the wind
+          const Eigen::Vector3d p_world = c.origin_world + c.R_world_lidar * (r * d_lidar);
+          const double t = t_start_s + col * dt_column;
+          p_lidar += c.R_world_lidar.transpose() *
+                     (sway_gain[pixel_id] * wind_field.displacement_m(p_world, t));
+        }
         px.p_sensor = (geometry_.T_sensor_lidar * p_lidar).cast<float>();
         px.intensity = static_cast<float>(100.0 * refl);  // reflectivity x cos(incidence), percent
       }
     }
   });
+
+  // Lost UDP packets: a whole packet's columns are missing from the frame.
+  if (params_.noise && params_.packet_loss_probability > 0.0) {
+    for (int first = 0; first < cols; first += kColumnsPerPacket) {
+      if (hashUniform(seed_, index, static_cast<std::uint64_t>(first), 104) >=
+          params_.packet_loss_probability)
+        continue;
+      const int end = std::min(cols, first + kColumnsPerPacket);
+      for (std::size_t i = static_cast<std::size_t>(first) * rows;
+           i < static_cast<std::size_t>(end) * rows; ++i)
+        pixels[i].valid = false;
+    }
+  }
 
   io::Scan scan;
   scan.index = index;

@@ -12,24 +12,68 @@
 #include "taiga/core/angles.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
+#include "taiga/sim/random.hpp"
 
 namespace taiga::sim::detail {
+namespace {
+/// The errors of the true rig beyond what its configuration holds.
+std::string trueRigComment(const Scenario& s) {
+  const ImuParams& imu = s.imu;
+  return fmt::format(
+      "# Realism '{}': true IMU noise densities {}x and bias walks {}x the stated ones (below);\n"
+      "#   Gauss-Markov biases {} m/s^2 and {} rad/s (1-sigma, {} s); scale errors {} and axis\n"
+      "#   misalignments {} deg (1-sigma); gyro g-sensitivity {} deg/s/g; clipping at {} g and {}\n"
+      "#   deg/s (0: none); stamp jitter {} s; lidar clock drift {} ppm (the offset below holds at\n"
+      "#   the start); extrinsic error {} deg and {} m; lidar: range noise at the limit {} m,\n"
+      "#   dropouts {}, packet loss {}; wind sway {} m at 20 m.\n",
+      s.realism, imu.noise_density_factor, imu.bias_walk_factor, imu.accel_bias_instability_mps2,
+      imu.gyro_bias_instability_radps, imu.bias_correlation_s, imu.scale_factor_error,
+      imu.misalignment_deg, imu.gyro_g_sensitivity_deg_s_per_g, imu.accel_range_g,
+      imu.gyro_range_deg_s, imu.timestamp_jitter_s, s.rig.lidar_clock_drift_ppm,
+      s.rig.extrinsic_rotation_error_deg, s.rig.extrinsic_translation_error_m,
+      s.lidar.range_noise_at_limit_m, s.lidar.dropout_probability,
+      s.lidar.packet_loss_probability, s.forest.wind_sway_m);
+}
 
-void writeRigYaml(const std::filesystem::path& path, const Simulation& simulation) {
+lie::SE3 statedTBodyLidar(const Simulation& simulation) {
+  const RigErrorParams& error = simulation.scenario().rig;
+  const lie::SE3 T_body_lidar = simulation.lidar().T_body_lidar();
+  if (error.extrinsic_rotation_error_deg <= 0.0 && error.extrinsic_translation_error_m <= 0.0)
+    return T_body_lidar;
+  // Fixed magnitudes, directions drawn from the seed: T_stated = T_true * Exp(error).
+  const std::uint64_t seed = streamSeed(simulation.seed(), "rig");
+  auto direction = [&](std::uint64_t stream) {
+    return Eigen::Vector3d(hashNormal(seed, stream, 0), hashNormal(seed, stream, 1),
+                           hashNormal(seed, stream, 2))
+        .normalized();
+  };
+  const lie::SE3 error_lidar(
+      lie::SO3::Exp(error.extrinsic_rotation_error_deg * kRadPerDeg * direction(1)),
+      error.extrinsic_translation_error_m * direction(2));
+  return T_body_lidar * error_lidar;
+}
+}  // namespace
+
+void writeRigYaml(const std::filesystem::path& path, const Simulation& simulation, RigView view) {
+  const bool truth = view == RigView::kTrue;
+  const ImuParams& imu = simulation.scenario().imu;
+  const RigErrorParams& rig_error = simulation.scenario().rig;
   SystemConfig config;
-  config.rig.T_body_lidar = simulation.lidar().T_body_lidar();
+  config.rig.T_body_lidar =
+      truth ? simulation.lidar().T_body_lidar() : statedTBodyLidar(simulation);
   config.rig.T_body_imu = lie::SE3();
-  config.rig.lidar_time_offset_s = 0.0;
+  config.rig.lidar_time_offset_s = truth ? rig_error.lidar_time_offset_s : 0.0;
   config.rig.imu_acceleration_unit = AccelerationUnit::kMetersPerSecond2;
   config.recording.lidar_topic = kLidarTopic;
   config.recording.imu_topic = kImuTopic;
   config.recording.gnss_topic = kGnssTopic;
   config.recording.scan_period_s = simulation.lidar().scanPeriod_s();
-  const ImuParams& imu = simulation.scenario().imu;
-  config.odometry.imu.accel_noise_density = imu.accel_noise_density;
-  config.odometry.imu.gyro_noise_density = imu.gyro_noise_density;
-  config.odometry.imu.accel_bias_random_walk = imu.accel_bias_random_walk;
-  config.odometry.imu.gyro_bias_random_walk = imu.gyro_bias_random_walk;
+  const double noise_factor = truth ? imu.noise_density_factor : 1.0;
+  const double walk_factor = truth ? imu.bias_walk_factor : 1.0;
+  config.odometry.imu.accel_noise_density = imu.accel_noise_density * noise_factor;
+  config.odometry.imu.gyro_noise_density = imu.gyro_noise_density * noise_factor;
+  config.odometry.imu.accel_bias_random_walk = imu.accel_bias_random_walk * walk_factor;
+  config.odometry.imu.gyro_bias_random_walk = imu.gyro_bias_random_walk * walk_factor;
   config.odometry.imu.gravity_mps2 = imu.gravity_mps2;
   if (simulation.lidar().rows() >= 64) {
     // Dense scans: the settings of config/os0-128-handheld.yaml (docs/odometry.md, "Scale").
@@ -38,20 +82,26 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
   }
   const LidarParams& lidar = simulation.scenario().lidar;
   std::string header = fmt::format(
-      "# Rig of a simulated recording (taiga simulate --scenario {} --seed {} --duration {}).\n"
+      "# Rig of a simulated recording (taiga simulate --scenario {} --seed {} --duration {}\n"
+      "# --realism {}): {}.\n"
       "# Body = IMU frame; the lidar frame is the Ouster sensor frame (points as the Ouster ROS\n"
       "# driver publishes them). Beam geometry: {}.\n"
-      "# Simulated noise (the IMU densities are also in odometry.imu below):\n"
+      "# Stated noise (datasheet; the IMU densities are also in odometry.imu below):\n"
       "#   IMU {} Hz: accelerometer noise {} m/s^2/sqrt(Hz), bias walk {} m/s^3/sqrt(Hz), turn-on "
       "{} m/s^2\n"
       "#              gyroscope noise {} rad/s/sqrt(Hz), bias walk {} rad/s^2/sqrt(Hz), turn-on {} "
       "rad/s\n"
       "#   lidar: range noise {} m + {} m per m, divergence {} deg\n",
       simulation.scenario().name, simulation.seed(), simulation.duration_s(),
+      simulation.scenario().realism,
+      truth ? "the true rig, as the simulator built it"
+            : "as its user would write it (nominal extrinsics, datasheet noise, no time offset;\n"
+              "# the truth is in rig_truth.yaml)",
       simulation.lidar().geometry().source, imu.rate_hz, imu.accel_noise_density,
       imu.accel_bias_random_walk, imu.accel_turn_on_bias, imu.gyro_noise_density,
       imu.gyro_bias_random_walk, imu.gyro_turn_on_bias, lidar.range_noise_m,
       lidar.range_noise_per_m, lidar.beam_divergence_deg);
+  if (truth) header += trueRigComment(simulation.scenario());
   if (simulation.motion().machine()) {
     header += cabinBoxRigComment();
     const OrientedBox cabin = HarvesterMachine::cabinInBody();  // axis-aligned in the body frame
@@ -68,6 +118,7 @@ void writeSceneJson(const std::filesystem::path& path, const Simulation& simulat
   const Scene& scene = simulation.scene();
   json j;
   j["scenario"] = s.name;
+  j["realism"] = s.realism;
   j["seed"] = simulation.seed();
   j["duration_s"] = simulation.duration_s();
   j["time_epoch_s"] = kRecordingEpoch_s;

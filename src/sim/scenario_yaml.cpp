@@ -11,6 +11,8 @@
 #include "taiga/core/config.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/io/config_yaml.hpp"
+#include "taiga/sim/realism.hpp"
+#include "taiga/sim/sensor_models.hpp"
 
 namespace taiga::sim {
 namespace {
@@ -95,6 +97,8 @@ const Field<ForestParams> kForestFields[] = {
     {"micro_relief_m", &ForestParams::micro_relief_m, "hummock amplitude, m", 0, 1},
     {"road_half_width_m", &ForestParams::road_half_width_m, "> 0: a strip road along world x, m", 0, 10},
     {"path_clearance_m", &ForestParams::path_clearance_m, "no stem closer to the path, m", 0, 10},
+    {"wind_sway_m", &ForestParams::wind_sway_m, "sway amplitude 20 m above ground (0: still), m", 0, 2},
+    {"wind_period_s", &ForestParams::wind_period_s, "period of the sway, s", 0.5, 60},
 };
 
 class ForestSection final : public TableSection<ForestParams> {
@@ -169,11 +173,10 @@ class MotionSection final : public TableSection<MotionParams> {
 // ---- sensors --------------------------------------------------------------------------------
 
 const Field<LidarParams> kLidarFields[] = {
-    {"metadata_json", &LidarParams::metadata_json, "Ouster metadata JSON (beam angles, frames)"},
-    {"beams", &LidarParams::beams, "rows, subsampled from the metadata", 1, 128},
+    {"metadata_json", &LidarParams::metadata_json, "Ouster metadata JSON instead of the model (empty: the model)"},
+    {"beams", &LidarParams::beams, "rows, subsampled from the beam table", 1, 128},
     {"columns", &LidarParams::columns, "firings per rotation", 16, 4096},
     {"rotation_hz", &LidarParams::rotation_hz, "frames per second", 1, 40},
-    {"fallback_vertical_fov_deg", &LidarParams::fallback_vertical_fov_deg, "without metadata, deg", 1, 180},
     {"min_range_m", &LidarParams::min_range_m, "closer returns are suppressed, m", 0, 10},
     {"max_range_m", &LidarParams::max_range_m, "for reflectivity 0.8 at normal incidence, m", 1, 500},
     {"range_noise_m", &LidarParams::range_noise_m, "1-sigma range noise at 0 m, m", 0, 1},
@@ -181,7 +184,21 @@ const Field<LidarParams> kLidarFields[] = {
     {"beam_divergence_deg", &LidarParams::beam_divergence_deg, "full angle of the footprint, deg", 0, 5},
     {"sub_rays", &LidarParams::sub_rays, "rays per beam at depth edges (1: no divergence)", 1, 8},
     {"dropout_probability", &LidarParams::dropout_probability, "random missing returns", 0, 1},
+    {"range_noise_at_limit_m", &LidarParams::range_noise_at_limit_m, "added 1-sigma noise at the detection limit, m", 0, 1},
+    {"packet_loss_probability", &LidarParams::packet_loss_probability, "share of lost 16-column packets", 0, 1},
     {"noise", &LidarParams::noise, "false: exact ranges, no dropouts"},
+};
+
+class LidarSection final : public TableSection<LidarParams> {
+ public:
+  explicit LidarSection(LidarParams& p) : TableSection(p, kLidarFields) {}
+
+ private:
+  void visitMore(ConfigVisitor& v) override {
+    const std::vector<std::string> names = sensorModelNames();
+    const std::vector<std::string_view> allowed(names.begin(), names.end());
+    v.choice("model", params_.model, allowed, "built-in beam table and frames");
+  }
 };
 
 const Field<ImuParams> kImuFields[] = {
@@ -193,6 +210,17 @@ const Field<ImuParams> kImuFields[] = {
     {"accel_turn_on_bias", &ImuParams::accel_turn_on_bias, "1-sigma per axis, m/s^2", 0, 5},
     {"gyro_turn_on_bias", &ImuParams::gyro_turn_on_bias, "1-sigma per axis, rad/s", 0, 1},
     {"gravity_mps2", &ImuParams::gravity_mps2, "m/s^2", 9, 10.5},
+    {"noise_density_factor", &ImuParams::noise_density_factor, "true / stated noise densities", 0, 100},
+    {"bias_walk_factor", &ImuParams::bias_walk_factor, "true / stated bias random walks", 0, 100},
+    {"accel_bias_instability_mps2", &ImuParams::accel_bias_instability_mps2, "1-sigma Gauss-Markov bias, m/s^2", 0, 1},
+    {"gyro_bias_instability_radps", &ImuParams::gyro_bias_instability_radps, "1-sigma Gauss-Markov bias, rad/s", 0, 0.1},
+    {"bias_correlation_s", &ImuParams::bias_correlation_s, "Gauss-Markov time of the biases, s", 0.1, 1e6},
+    {"scale_factor_error", &ImuParams::scale_factor_error, "1-sigma per-axis scale error (0.01 = 1 %)", 0, 0.2},
+    {"misalignment_deg", &ImuParams::misalignment_deg, "1-sigma axis non-orthogonality, deg", 0, 10},
+    {"gyro_g_sensitivity_deg_s_per_g", &ImuParams::gyro_g_sensitivity_deg_s_per_g, "1-sigma gyro error per g, deg/s/g", 0, 10},
+    {"accel_range_g", &ImuParams::accel_range_g, "clipping of the accelerometer (0: none), g", 0, 100},
+    {"gyro_range_deg_s", &ImuParams::gyro_range_deg_s, "clipping of the gyroscope (0: none), deg/s", 0, 10000},
+    {"timestamp_jitter_s", &ImuParams::timestamp_jitter_s, "1-sigma error of each stamp, s", 0, 0.1},
     {"noise", &ImuParams::noise, "false: exact specific force and angular rate"},
     {"orientation_output", &ImuParams::orientation_output, "samples carry an AHRS orientation"},
     {"orientation_tilt_error_deg", &ImuParams::orientation_tilt_error_deg, "1-sigma roll/pitch error, deg", 0, 30},
@@ -219,6 +247,13 @@ const Field<GnssParams> kGnssFields[] = {
     {"noise", &GnssParams::noise, "false: exact positions, no outages"},
 };
 
+const Field<RigErrorParams> kRigFields[] = {
+    {"extrinsic_rotation_error_deg", &RigErrorParams::extrinsic_rotation_error_deg, "true vs stated T_body_lidar, deg", 0, 180},
+    {"extrinsic_translation_error_m", &RigErrorParams::extrinsic_translation_error_m, "true vs stated lever arm, m", 0, 10},
+    {"lidar_time_offset_s", &RigErrorParams::lidar_time_offset_s, "true rig.lidar_time_offset_s, s", -1, 1},
+    {"lidar_clock_drift_ppm", &RigErrorParams::lidar_clock_drift_ppm, "lidar clock rate error, ppm", -1000, 1000},
+};
+
 const Field<Scenario> kScenarioFields[] = {
     {"duration_s", &Scenario::duration_s, "recording length without --duration, s", 0.1, 86400},
 };
@@ -229,15 +264,20 @@ class ScenarioSection final : public TableSection<Scenario> {
       : TableSection(s, kScenarioFields),
         forest_(s.forest),
         motion_(s.motion),
-        lidar_(s.lidar, kLidarFields),
+        lidar_(s.lidar),
         imu_(s.imu, kImuFields),
-        gnss_(s.gnss, kGnssFields) {}
+        gnss_(s.gnss, kGnssFields),
+        rig_(s.rig, kRigFields) {}
 
  private:
   void visit(ConfigVisitor& v) override {
     const std::vector<std::string> names = scenarioNames();
     const std::vector<std::string_view> allowed(names.begin(), names.end());
     v.choice("name", params_.name, allowed, "the scenario this file describes");
+    const std::vector<std::string> presets = realismNames();
+    const std::vector<std::string_view> realism(presets.begin(), presets.end());
+    v.choice("realism", params_.realism, realism,
+             "the preset the error fields came from (the fields are what is simulated)");
     TableSection::visit(v);
   }
   void visitMore(ConfigVisitor& v) override {
@@ -246,12 +286,14 @@ class ScenarioSection final : public TableSection<Scenario> {
     v.section("lidar", lidar_, "the lidar");
     v.section("imu", imu_, "the IMU");
     v.section("gnss", gnss_, "the GNSS receiver and the world frame's georeference");
+    v.section("rig", rig_, "how the true rig differs from its rig.yaml");
   }
   ForestSection forest_;
   MotionSection motion_;
-  TableSection<LidarParams> lidar_;
+  LidarSection lidar_;
   TableSection<ImuParams> imu_;
   TableSection<GnssParams> gnss_;
+  TableSection<RigErrorParams> rig_;
 };
 
 }  // namespace

@@ -130,6 +130,7 @@ struct Scene::Impl {
   ForestParams params;
   SceneLayout layout;
   Terrain terrain;
+  Wind wind;
   detail::ForestContents contents;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
@@ -138,7 +139,7 @@ struct Scene::Impl {
   RTCScene query_scene = nullptr;
 
   Impl(const ForestParams& p, std::uint64_t seed, SceneLayout l)
-      : params(p), layout(std::move(l)), terrain(p, seed) {
+      : params(p), layout(std::move(l)), terrain(p, seed), wind(p, seed) {
     contents = detail::buildForest(params, seed, layout, terrain);
     device = rtcNewDevice(nullptr);
     if (!device) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -371,6 +372,7 @@ CurveSegment Scene::curveSegment(std::int32_t index) const {
 }
 
 const Terrain& Scene::terrain() const { return impl_->terrain; }
+const Wind& Scene::wind() const { return impl_->wind; }
 const SceneLayout& Scene::layout() const { return impl_->layout; }
 const std::vector<Tree>& Scene::trees() const { return impl_->contents.trees; }
 const std::vector<Boulder>& Scene::boulders() const { return impl_->contents.boulders; }

@@ -16,6 +16,16 @@ namespace {
 /// Beyond the loop, the plot extends this far: about the useful range of the lidar, m.
 constexpr double kPlotMargin_m = 35.0;
 
+/// Lidar stamp - motion time of a scan starting at motion time t_start_s: the recording epoch,
+/// minus the rig's time offset (rig.lidar_time_offset_s puts lidar times on the IMU clock, whose
+/// stamps are motion time + epoch), plus the drift of the lidar's clock. The drift within one
+/// scan (5 us at 50 ppm) is neglected.
+double lidarClockOffset_s(const RigErrorParams& rig, double t_start_s) {
+  if (rig.lidar_time_offset_s == 0.0 && rig.lidar_clock_drift_ppm == 0.0)
+    return kRecordingEpoch_s;
+  return kRecordingEpoch_s - rig.lidar_time_offset_s + rig.lidar_clock_drift_ppm * 1e-6 * t_start_s;
+}
+
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -85,11 +95,12 @@ SimulationSummary writeSimulation(const Simulation& simulation,
                           static_cast<std::uint32_t>(lidar.columns())};
   for (std::size_t k = 0; k < scans; ++k) {
     const double t_start = static_cast<double>(k) * lidar.scanPeriod_s();
-    const io::Scan scan = lidar.simulateScan(scene, motion, k, t_start, kRecordingEpoch_s);
-    emitUntil(scan.t_end_s - kRecordingEpoch_s);
+    const double lidar_clock_s = lidarClockOffset_s(scenario.rig, t_start);
+    const io::Scan scan = lidar.simulateScan(scene, motion, k, t_start, lidar_clock_s);
+    const double t_end = scan.t_end_s - lidar_clock_s;  // motion time: the scan is complete
+    emitUntil(t_end);
     bag.writeScan(kLidarTopic, "os_sensor", scan, grid);
-    if (machine_boxes)
-      machine_boxes->writeScan(scan.t_start_s, t_start, scan.t_end_s - kRecordingEpoch_s);
+    if (machine_boxes) machine_boxes->writeScan(scan.t_start_s, t_start, t_end);
     const std::size_t n = scan.cloud_in_lidar.size();
     summary.points += n;
     summary.min_points_per_scan = std::min(summary.min_points_per_scan, n);
@@ -103,7 +114,8 @@ SimulationSummary writeSimulation(const Simulation& simulation,
   summary.path_length_m = ground_truth.size() > 1 ? ground_truth.pathLength() : 0.0;
 
   io::writeTum(out_dir / "groundtruth.tum", ground_truth);
-  detail::writeRigYaml(out_dir / "rig.yaml", simulation);
+  detail::writeRigYaml(out_dir / "rig.yaml", simulation, detail::RigView::kStated);
+  detail::writeRigYaml(out_dir / "rig_truth.yaml", simulation, detail::RigView::kTrue);
   summary.simulate_s = secondsSince(start);
   detail::writeSceneJson(out_dir / "scene.json", simulation, summary);
   return summary;

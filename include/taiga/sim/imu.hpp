@@ -11,8 +11,14 @@
 // with a tilt error e (first-order Gauss-Markov per axis, sigma_tilt, time constant tau:
 // e_k+1 = phi e_k + sqrt(1 - phi^2) sigma_tilt n, phi = exp(-dt / tau)) and a heading error
 // psi_k = offset + random walk (psi_k+1 = psi_k + q sqrt(dt) n). With noise = false the reported
-// orientation is exact. Not modelled: scale factors, misalignment, g-sensitivity, temperature,
-// the filter's response to accelerations (its tilt error does not grow in turns).
+// orientation is exact. Not modelled: temperature, the filter's response to accelerations (its
+// tilt error does not grow in turns).
+//
+// Realism (docs/simulator.md, "Realism"; all off in the ideal preset): the true noise densities
+// and bias walks are the stated ones times noise_density_factor and bias_walk_factor; the
+// measured vectors are M f_true (M = I + scale errors + axis misalignments, drawn per seed) with
+// a gyro g-sensitivity G f_true, a first-order Gauss-Markov bias on top of the random walk, and
+// clipping at the sensor's range; each stamp carries jitter.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -39,8 +45,10 @@ class ImuSimulator {
   double nextTime_s() const { return static_cast<double>(k_) / params_.rate_hz; }
   /// The next sample; its time is motion time + time_offset_s.
   ImuSample next(const WalkingMotion& motion, double time_offset_s = 0.0);
-  /// Biases applied to the last sample returned (the turn-on biases before the first).
+  /// Turn-on and random-walk biases applied to the last sample returned (the turn-on biases
+  /// before the first); the Gauss-Markov part is markovBiases().
   const ImuBiases& biases() const { return biases_; }
+  const ImuBiases& markovBiases() const { return markov_; }
   /// Errors of the orientation given with the last sample: tilt about east and north, heading
   /// about up, rad (zero when the output is off or noise is false).
   Eigen::Vector3d orientationError_rad() const {
@@ -49,11 +57,20 @@ class ImuSimulator {
 
  private:
   void advanceOrientationError();
+  void advanceMarkovBiases(double dt);
+  bool hasMarkovBiases() const {
+    return params_.accel_bias_instability_mps2 > 0.0 || params_.gyro_bias_instability_radps > 0.0;
+  }
 
   ImuParams params_;
   std::uint64_t seed_;
   std::uint64_t k_ = 0;
   ImuBiases biases_;
+  ImuBiases markov_;
+  bool has_axis_errors_ = false;
+  Eigen::Matrix3d M_accel_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d M_gyro_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d G_gyro_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d R_enu_world_ = Eigen::Matrix3d::Identity();
   Eigen::Vector2d tilt_error_rad_ = Eigen::Vector2d::Zero();
   double heading_error_rad_ = 0.0;

@@ -35,12 +35,12 @@ struct LidarGeometry {
   double beam_origin_z_m = 0.0;
   lie::SE3 T_sensor_lidar;  ///< Ouster lidar frame in the Ouster sensor frame
   lie::SE3 T_sensor_imu;    ///< the IMU (= body frame) in the Ouster sensor frame
-  std::string source;       ///< the metadata file, or "uniform fallback"
+  std::string source;       ///< the metadata file, or "built-in <model>"
 };
 
-/// Reads the metadata named in params (subsampling rows evenly to params.beams), or, when the
-/// file is missing, spreads params.beams rows uniformly over the fallback field of view with a
-/// logged warning. Throws InputError for a file that exists but cannot be read.
+/// The built-in model params.model (sensor_models.hpp), or the Ouster metadata file
+/// params.metadata_json when one is named, with its rows evenly subsampled to params.beams.
+/// InputError for an unknown model or a file that is missing or cannot be read.
 LidarGeometry loadLidarGeometry(const LidarParams& params);
 
 class LidarSimulator {

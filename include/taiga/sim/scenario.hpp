@@ -30,6 +30,11 @@ struct ForestParams {
   double micro_relief_m = 0.12;       ///< amplitude of the short-wave relief (hummocks), m
   double road_half_width_m = 0.0;     ///< > 0: a strip road along the world x axis without trees
   double path_clearance_m = 1.0;      ///< no stem closer than this to the walked path, m
+  /// Wind: horizontal sway of stems, branches and foliage (0: the forest stands still). The
+  /// amplitude at 20 m above the ground, m; it grows linearly from 2 m up, doubled for branches
+  /// and foliage (docs/simulator.md, "Realism").
+  double wind_sway_m = 0.0;
+  double wind_period_s = 4.0;  ///< period of the sway (conifers sway at about 0.2-0.4 Hz), s
 };
 
 /// Which rig moves through the forest.
@@ -91,13 +96,15 @@ struct MotionParams {
 };
 
 struct LidarParams {
-  /// Ouster metadata JSON for beam altitude angles and frames; empty or missing: a uniform
-  /// spread over `fallback_vertical_fov_deg` with a warning.
-  std::string metadata_json = "../shared/data/ouster/OS-0-128-U1_v2.3.0_1024x10.json";
-  int beams = 128;            ///< rows; fewer than the metadata's: evenly subsampled
+  /// Beam table and frames: one of the sensor models built into taiga (`os0-128`, see
+  /// sensor_models.hpp), used when metadata_json is empty.
+  std::string model = "os0-128";
+  /// An Ouster metadata JSON (beam angles, frames) instead of the built-in model; a file that
+  /// cannot be read is an error.
+  std::string metadata_json;
+  int beams = 128;            ///< rows; fewer than the table's: evenly subsampled
   int columns = 1024;         ///< firings per rotation (512, 1024, 2048)
   double rotation_hz = 10.0;  ///< frames per second
-  double fallback_vertical_fov_deg = 90.0;
   double min_range_m = 0.5;     ///< closer returns are suppressed (operator, stick)
   double max_range_m = 45.0;    ///< for a bright target (reflectivity 0.8) at normal incidence
   double range_noise_m = 0.01;  ///< 1-sigma range noise at 0 m
@@ -105,13 +112,19 @@ struct LidarParams {
   double beam_divergence_deg = 0.35;  ///< full angle of the beam footprint
   int sub_rays = 4;                   ///< rays per beam to model the footprint (1 = no divergence)
   double dropout_probability = 0.01;  ///< random missing returns
+  /// additional 1-sigma range noise of a return at its detection limit, m; it grows with the
+  /// square of range / detection limit (weak, dark or far returns are noisier)
+  double range_noise_at_limit_m = 0.0;
+  double packet_loss_probability = 0.0;  ///< share of lost UDP packets (16 columns each)
   bool noise = true;                  ///< false: exact ranges, no dropouts (for tests)
 };
 
 struct ImuParams {
   double rate_hz = 200.0;
-  /// Continuous-time white-noise densities and bias random walks (a consumer/industrial MEMS
-  /// unit such as the ICM-20948 inside Ouster sensors; see docs/simulator.md).
+  /// Continuous-time white-noise densities and bias random walks as the datasheet states them
+  /// (a consumer/industrial MEMS unit such as the ICM-20948 inside Ouster sensors; see
+  /// docs/simulator.md); rig.yaml gets these. The simulated ones are these times the factors
+  /// below.
   double accel_noise_density = 2.0e-3;     ///< m/s^2/sqrt(Hz)
   double gyro_noise_density = 2.5e-4;      ///< rad/s/sqrt(Hz)
   double accel_bias_random_walk = 1.0e-4;  ///< m/s^3/sqrt(Hz)
@@ -119,6 +132,18 @@ struct ImuParams {
   double accel_turn_on_bias = 0.05;        ///< 1-sigma bias per axis at start, m/s^2
   double gyro_turn_on_bias = 2.0e-3;       ///< 1-sigma bias per axis at start, rad/s
   double gravity_mps2 = 9.81;
+  // Errors the datasheet and rig.yaml do not state (docs/simulator.md, "Realism").
+  double noise_density_factor = 1.0;  ///< true / stated white-noise densities
+  double bias_walk_factor = 1.0;      ///< true / stated bias random walks
+  double accel_bias_instability_mps2 = 0.0;  ///< 1-sigma Gauss-Markov bias, m/s^2
+  double gyro_bias_instability_radps = 0.0;  ///< 1-sigma Gauss-Markov bias, rad/s
+  double bias_correlation_s = 100.0;         ///< time constant of the Gauss-Markov biases, s
+  double scale_factor_error = 0.0;           ///< 1-sigma per-axis scale error (0.01 = 1 %)
+  double misalignment_deg = 0.0;             ///< 1-sigma axis non-orthogonality, deg
+  double gyro_g_sensitivity_deg_s_per_g = 0.0;  ///< 1-sigma gyro error per g of specific force
+  double accel_range_g = 0.0;                ///< > 0: the accelerometer clips at +-this, g
+  double gyro_range_deg_s = 0.0;             ///< > 0: the gyroscope clips at +-this, deg/s
+  double timestamp_jitter_s = 0.0;           ///< 1-sigma error of each sample's stamp, s
   bool noise = true;  ///< false: exact specific force and angular rate
   /// true: each sample carries the orientation of an internal attitude filter (AHRS without a
   /// magnetometer), as 9-axis IMU modules report it; false: a 6-axis IMU such as the one inside
@@ -153,14 +178,31 @@ struct GnssParams {
   bool noise = true;
 };
 
+/// How the rig as built differs from the rig.yaml a user would write (docs/simulator.md,
+/// "Realism"). rig.yaml states the nominal values; rig_truth.yaml the true ones.
+struct RigErrorParams {
+  /// angle of the rotation between the true and the stated T_body_lidar (axis drawn from the
+  /// seed), deg
+  double extrinsic_rotation_error_deg = 0.0;
+  double extrinsic_translation_error_m = 0.0;  ///< length of the lever-arm error, m
+  /// the true rig.lidar_time_offset_s: lidar stamps are late on the IMU clock by minus this
+  /// (what must be added to lidar times to put them on the IMU clock), s
+  double lidar_time_offset_s = 0.0;
+  double lidar_clock_drift_ppm = 0.0;  ///< the lidar clock runs fast against the IMU's, ppm
+};
+
 struct Scenario {
   std::string name = "mixed";
+  /// The realism preset the errors came from (`ideal`, `typical`, `harsh`; realism.hpp); the
+  /// fields themselves are what is simulated.
+  std::string realism = "ideal";
   double duration_s = 60.0;  ///< length of the recording when `--duration` is not given, s
   ForestParams forest;
   MotionParams motion;
   LidarParams lidar;
   ImuParams imu;
   GnssParams gnss;
+  RigErrorParams rig;
 };
 
 /// The scenarios `taiga simulate --scenario` knows (canonical names).

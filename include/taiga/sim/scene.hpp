@@ -17,6 +17,7 @@
 
 #include "taiga/sim/scenario.hpp"
 #include "taiga/sim/terrain.hpp"
+#include "taiga/sim/wind.hpp"
 
 namespace taiga::sim {
 
@@ -126,6 +127,7 @@ class Scene {
   CurveSegment curveSegment(std::int32_t index) const;
 
   const Terrain& terrain() const;
+  const Wind& wind() const;  ///< how the stems and crowns sway (calm unless wind_sway_m > 0)
   const SceneLayout& layout() const;
   const std::vector<Tree>& trees() const;
   const std::vector<Boulder>& boulders() const;

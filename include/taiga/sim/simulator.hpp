@@ -4,7 +4,10 @@
 //   recording.bag      /os_cloud_node/points (Ouster PointCloud2, organized rows x columns),
 //                      /imu/data (sensor_msgs/Imu), /gnss/fix (sensor_msgs/NavSatFix)
 //   groundtruth.tum    T_world_body at the IMU rate (body = IMU frame)
-//   rig.yaml           the configuration `taiga run` uses for this recording
+//   rig.yaml           the configuration a user would write for this rig (nominal extrinsics,
+//                      datasheet noise, no time offset)
+//   rig_truth.yaml     the same keys with the true values (realism.hpp: equal to rig.yaml but
+//                      for comments in the ideal preset)
 //   scene.json         scenario, seed, georeference of the world frame, every stem's truth
 //   trees.csv          one row per stem: base position, DBH, height, lean, species
 //   georef_truth.yaml  the world frame in EPSG:3067 (origin, rotation, scale, T_epsg_world);
