@@ -1,6 +1,8 @@
 // The simulated lidar: deterministic whatever the thread count, points on true surfaces when
 // transformed by the true pose at their column's time, sensible returns per scan.
 #include <gtest/gtest.h>
+
+#include "taiga/core/errors.hpp"
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -159,20 +161,31 @@ TEST(Lidar, ScanTimesColumnsAndReturns) {
   }
 }
 
-TEST(Lidar, HeadsOfOtherSizesAndTheFallbackGeometry) {
+TEST(Lidar, BuiltInHeadsAndMetadataFiles) {
   LidarParams params;
   params.beams = 64;
-  const LidarGeometry g = loadLidarGeometry(params);
+  const LidarGeometry g = loadLidarGeometry(params);  // built in: no file, whatever the directory
+  EXPECT_EQ(g.source, "built-in os0-128");
   ASSERT_EQ(g.beam_altitude_deg.size(), 64u);
-  EXPECT_GT(g.beam_altitude_deg.front(), 40.0);  // OS0: about +-45 deg
-  EXPECT_LT(g.beam_altitude_deg.back(), -40.0);
+  EXPECT_DOUBLE_EQ(g.beam_altitude_deg.front(), 45.0);  // OS0: +-45 deg
+  EXPECT_DOUBLE_EQ(g.beam_altitude_deg.back(), -45.0);
+  // A real OS0-128's metadata: the same head to within its unit's calibration.
+  params.metadata_json = "../shared/data/ouster/OS-0-128-U1_v2.3.0_1024x10.json";
+  const LidarGeometry real = loadLidarGeometry(params);
+  ASSERT_EQ(real.beam_altitude_deg.size(), 64u);
+  for (std::size_t i = 0; i < 64; ++i) {
+    EXPECT_NEAR(real.beam_altitude_deg[i], g.beam_altitude_deg[i], 1.5) << i;
+    EXPECT_NEAR(real.beam_azimuth_deg[i], g.beam_azimuth_deg[i], 2.5) << i;
+  }
+  EXPECT_LT((g.T_sensor_imu.translation() - real.T_sensor_imu.translation()).norm(), 1e-9);
+  EXPECT_LT((g.T_sensor_lidar.translation() - real.T_sensor_lidar.translation()).norm(), 1e-9);
+  EXPECT_NEAR(g.lidar_origin_to_beam_origin_m, real.lidar_origin_to_beam_origin_m, 1e-9);
+  // A file that is not there, or a model that is not built in, is an error, never a fallback.
   params.metadata_json = "does/not/exist.json";
-  const LidarGeometry fallback = loadLidarGeometry(params);
-  EXPECT_EQ(fallback.source, "uniform fallback");
-  EXPECT_DOUBLE_EQ(fallback.beam_altitude_deg.front(), 45.0);
-  EXPECT_DOUBLE_EQ(fallback.beam_altitude_deg.back(), -45.0);
-  // Both give the same rig: T_body_lidar from the OS0's IMU and sensor frames.
-  EXPECT_LT((g.T_sensor_imu.translation() - fallback.T_sensor_imu.translation()).norm(), 1e-9);
+  EXPECT_THROW(loadLidarGeometry(params), InputError);
+  params.metadata_json.clear();
+  params.model = "os9-1024";
+  EXPECT_THROW(loadLidarGeometry(params), InputError);
 }
 
 }  // namespace
