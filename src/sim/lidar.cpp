@@ -62,8 +62,8 @@ struct SubHit {
 }  // namespace
 
 LidarGeometry loadLidarGeometry(const LidarParams& params) {
-  if (params.beams < 1)
-    throw InputError(fmt::format("lidar.beams: expected at least 1, found {}", params.beams));
+  if (params.beams < 0)
+    throw InputError(fmt::format("lidar.beams: expected 0 (all) or more, found {}", params.beams));
   if (params.columns < 16)
     throw InputError(fmt::format("lidar.columns: expected at least 16, found {}", params.columns));
   LidarGeometry full;
@@ -83,6 +83,7 @@ LidarGeometry loadLidarGeometry(const LidarParams& params) {
     full.source = params.metadata_json;
   }
   const auto n = static_cast<int>(full.beam_altitude_deg.size());
+  if (params.beams == 0) return full;
   if (params.beams > n)
     throw InputError(fmt::format("lidar.beams: {} has {} beams, {} were asked for", full.source,
                                  n, params.beams));

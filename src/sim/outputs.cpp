@@ -65,8 +65,9 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
   config.rig.lidar_time_offset_s = truth ? rig_error.lidar_time_offset_s : 0.0;
   config.rig.imu_acceleration_unit = AccelerationUnit::kMetersPerSecond2;
   config.recording.lidar_topic = kLidarTopic;
-  config.recording.imu_topic = kImuTopic;
-  config.recording.gnss_topic = kGnssTopic;
+  const OutputParams& output = simulation.scenario().output;
+  config.recording.imu_topic = output.imu ? kImuTopic : "";
+  config.recording.gnss_topic = output.gnss ? kGnssTopic : "";
   config.recording.scan_period_s = simulation.lidar().scanPeriod_s();
   const double noise_factor = truth ? imu.noise_density_factor : 1.0;
   const double walk_factor = truth ? imu.bias_walk_factor : 1.0;

@@ -174,7 +174,7 @@ class MotionSection final : public TableSection<MotionParams> {
 
 const Field<LidarParams> kLidarFields[] = {
     {"metadata_json", &LidarParams::metadata_json, "Ouster metadata JSON instead of the model (empty: the model)"},
-    {"beams", &LidarParams::beams, "rows, subsampled from the beam table", 1, 128},
+    {"beams", &LidarParams::beams, "rows, subsampled from the beam table (0: all)", 0, 128},
     {"columns", &LidarParams::columns, "firings per rotation", 16, 4096},
     {"rotation_hz", &LidarParams::rotation_hz, "frames per second", 1, 40},
     {"min_range_m", &LidarParams::min_range_m, "closer returns are suppressed, m", 0, 10},
@@ -254,6 +254,24 @@ const Field<RigErrorParams> kRigFields[] = {
     {"lidar_clock_drift_ppm", &RigErrorParams::lidar_clock_drift_ppm, "lidar clock rate error, ppm", -1000, 1000},
 };
 
+const Field<OutputParams> kOutputFields[] = {
+    {"scan_stride", &OutputParams::scan_stride, "keep every n-th scan", 1, 1000},
+    {"imu", &OutputParams::imu, "write the IMU topic"},
+    {"gnss", &OutputParams::gnss, "write the GNSS topic"},
+};
+
+class OutputSection final : public TableSection<OutputParams> {
+ public:
+  explicit OutputSection(OutputParams& p) : TableSection(p, kOutputFields) {}
+
+ private:
+  void visitMore(ConfigVisitor& v) override {
+    static constexpr std::string_view kLayouts[] = {"ouster", "velodyne", "deskewed"};
+    v.choice("point_layout", params_.point_layout, kLayouts,
+             "ouster (organized, t), velodyne (flat, ring, time), deskewed (flat, no time)");
+  }
+};
+
 const Field<Scenario> kScenarioFields[] = {
     {"duration_s", &Scenario::duration_s, "recording length without --duration, s", 0.1, 86400},
 };
@@ -267,7 +285,8 @@ class ScenarioSection final : public TableSection<Scenario> {
         lidar_(s.lidar),
         imu_(s.imu, kImuFields),
         gnss_(s.gnss, kGnssFields),
-        rig_(s.rig, kRigFields) {}
+        rig_(s.rig, kRigFields),
+        output_(s.output) {}
 
  private:
   void visit(ConfigVisitor& v) override {
@@ -287,6 +306,7 @@ class ScenarioSection final : public TableSection<Scenario> {
     v.section("imu", imu_, "the IMU");
     v.section("gnss", gnss_, "the GNSS receiver and the world frame's georeference");
     v.section("rig", rig_, "how the true rig differs from its rig.yaml");
+    v.section("output", output_, "what the recording holds");
   }
   ForestSection forest_;
   MotionSection motion_;
@@ -294,6 +314,7 @@ class ScenarioSection final : public TableSection<Scenario> {
   TableSection<ImuParams> imu_;
   TableSection<GnssParams> gnss_;
   TableSection<RigErrorParams> rig_;
+  OutputSection output_;
 };
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <numbers>
+#include <vector>
 
 #include "taiga/core/errors.hpp"
 
@@ -31,11 +32,40 @@ LidarGeometry os0_128() {
   return g;
 }
 
+/// A Velodyne-like head: beams fired from one column, no beam-origin offset, the points in the
+/// sensor frame; no IMU of its own, so the rig's IMU is taken 10 cm below the sensor, unrotated
+/// (a typical mount of an external IMU module).
+LidarGeometry velodyne(std::vector<double> altitudes_deg, const char* name) {
+  LidarGeometry g;
+  g.beam_altitude_deg = std::move(altitudes_deg);
+  g.beam_azimuth_deg.assign(g.beam_altitude_deg.size(), 0.0);
+  g.T_sensor_imu = lie::SE3(lie::SO3(), Eigen::Vector3d(0.0, 0.0, -0.10));
+  g.source = fmt::format("built-in {}", name);
+  return g;
+}
+
+/// Velodyne VLP-16 (datasheet): 16 beams from +15 to -15 deg, 2 deg apart (rows top to bottom
+/// as the other models; the driver's ring numbers differ). At 10 Hz it fires 1800 times per
+/// rotation: `lidar: {model: vlp-16, columns: 1800}`.
+LidarGeometry vlp16() {
+  std::vector<double> a;
+  for (int i = 0; i < 16; ++i) a.push_back(15.0 - 2.0 * i);
+  return velodyne(std::move(a), "vlp-16");
+}
+
+/// Velodyne HDL-32E (datasheet): 32 beams from +10.67 to -30.67 deg, 1.33 deg apart; about 2170
+/// firings per rotation at 10 Hz (`columns: 2048` is close).
+LidarGeometry hdl32e() {
+  std::vector<double> a;
+  for (int i = 0; i < 32; ++i) a.push_back(10.67 - (10.67 + 30.67) * i / 31.0);
+  return velodyne(std::move(a), "hdl-32e");
+}
+
 struct Model {
   const char* name;
   LidarGeometry (*make)();
 };
-constexpr Model kModels[] = {{"os0-128", os0_128}};
+constexpr Model kModels[] = {{"os0-128", os0_128}, {"vlp-16", vlp16}, {"hdl-32e", hdl32e}};
 
 }  // namespace
 

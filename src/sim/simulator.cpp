@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "machine_boxes_output.hpp"
 #include "outputs.hpp"
@@ -24,6 +25,29 @@ double lidarClockOffset_s(const RigErrorParams& rig, double t_start_s) {
   if (rig.lidar_time_offset_s == 0.0 && rig.lidar_clock_drift_ppm == 0.0)
     return kRecordingEpoch_s;
   return kRecordingEpoch_s - rig.lidar_time_offset_s + rig.lidar_clock_drift_ppm * 1e-6 * t_start_s;
+}
+
+/// A scan as a front end that deskews upstream republishes it: every point moved, with the true
+/// motion, into the lidar frame at the scan's start (the header stamp), and no per-point times.
+void deskewWithTruth(io::Scan& scan, const WalkingMotion& motion, const lie::SE3& T_body_lidar,
+                     double lidar_clock_s) {
+  PointCloud& cloud = scan.cloud_in_lidar;
+  auto T_world_lidar = [&](double t_lidar_s) {
+    return motion.at(t_lidar_s - lidar_clock_s).T_world_body * T_body_lidar;
+  };
+  const lie::SE3 T_start_world = T_world_lidar(scan.t_start_s).inverse();
+  lie::SE3 T_start_point;
+  double t_cached = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (cloud.times_s[i] != t_cached) {  // one pose per column: its points share a time
+      t_cached = cloud.times_s[i];
+      T_start_point = T_start_world * T_world_lidar(t_cached);
+    }
+    cloud.positions[i] = T_start_point * cloud.positions[i];
+  }
+  cloud.times_s.clear();
+  cloud.rings.clear();
+  cloud.columns.clear();
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
@@ -75,12 +99,16 @@ SimulationSummary writeSimulation(const Simulation& simulation,
     while (imu.nextTime_s() <= t_end_s) {
       const double t = imu.nextTime_s();
       const ImuSample sample = imu.next(motion, kRecordingEpoch_s);
-      bag.writeImu(kImuTopic, "os_imu", sample);
-      ground_truth.append(sample.t_s, motion.at(t).T_world_body);
-      ++summary.imu_samples;
+      if (scenario.output.imu) {
+        bag.writeImu(kImuTopic, "os_imu", sample);
+        ++summary.imu_samples;
+      }
+      // The truth at the IMU's instants (not its jittered stamps).
+      ground_truth.append(t + kRecordingEpoch_s, motion.at(t).T_world_body);
     }
     while (gnss.nextTime_s() <= t_end_s) {
       if (const auto fix = gnss.next(motion, scene, kRecordingEpoch_s)) {
+        if (!scenario.output.gnss) continue;
         bag.writeGnss(kGnssTopic, "gnss", *fix);
         ++summary.gnss_fixes;
       }
@@ -90,16 +118,28 @@ SimulationSummary writeSimulation(const Simulation& simulation,
   std::optional<detail::MachineBoxesWriter> machine_boxes;  // harvester: crop boxes per scan
   if (const HarvesterMachine* machine = motion.machine())
     machine_boxes.emplace(out_dir / "machine_boxes.csv", *machine);
+  const OutputParams& output = scenario.output;
   const std::size_t scans = simulation.scanCount();
   const io::ScanGrid grid{static_cast<std::uint32_t>(lidar.rows()),
                           static_cast<std::uint32_t>(lidar.columns())};
   for (std::size_t k = 0; k < scans; ++k) {
+    if (k % static_cast<std::size_t>(output.scan_stride) != 0) {
+      if (on_scan) on_scan(k + 1, scans);
+      continue;
+    }
     const double t_start = static_cast<double>(k) * lidar.scanPeriod_s();
     const double lidar_clock_s = lidarClockOffset_s(scenario.rig, t_start);
-    const io::Scan scan = lidar.simulateScan(scene, motion, k, t_start, lidar_clock_s);
+    io::Scan scan = lidar.simulateScan(scene, motion, k, t_start, lidar_clock_s);
     const double t_end = scan.t_end_s - lidar_clock_s;  // motion time: the scan is complete
     emitUntil(t_end);
-    bag.writeScan(kLidarTopic, "os_sensor", scan, grid);
+    if (output.point_layout == "velodyne") {
+      bag.writeScanAs(io::ScanLayout::kVelodyne, kLidarTopic, "velodyne", scan);
+    } else if (output.point_layout == "deskewed") {
+      deskewWithTruth(scan, motion, lidar.T_body_lidar(), lidar_clock_s);
+      bag.writeScanAs(io::ScanLayout::kXyzi, kLidarTopic, "os_sensor", scan);
+    } else {
+      bag.writeScan(kLidarTopic, "os_sensor", scan, grid);
+    }
     if (machine_boxes) machine_boxes->writeScan(scan.t_start_s, t_start, t_end);
     const std::size_t n = scan.cloud_in_lidar.size();
     summary.points += n;

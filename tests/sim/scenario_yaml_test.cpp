@@ -115,7 +115,7 @@ TEST(ScenarioYaml, ValuesOutOfRangeAreInputErrors) {
   EXPECT_NE(dbh.find("overrides.yaml:2:3: forest.dbh_mean_m: expected a value in [0.08, 0.5], got 2"),
             std::string::npos)
       << dbh;
-  EXPECT_NE(overrideError("lidar: {beams: 0}\n").find("lidar.beams: expected a value in [1, 128]"),
+  EXPECT_NE(overrideError("lidar: {beams: -1}\n").find("lidar.beams: expected a value in [0, 128]"),
             std::string::npos);
   EXPECT_NE(overrideError("imu: {rate_hz: -200}\n").find("imu.rate_hz: expected a value in"),
             std::string::npos);

@@ -54,6 +54,13 @@ struct ScanGrid {
   std::uint32_t columns = 0;
 };
 
+/// Point layouts of other drivers (BagWriter::writeScanAs).
+enum class ScanLayout {
+  kVelodyne,  ///< velodyne_pointcloud XYZIRT: x y z intensity (float32), ring (uint16), time
+              ///< (float32, s after the header stamp); flat
+  kXyzi,      ///< x y z intensity (float32) only, flat: a cloud deskewed upstream, no time field
+};
+
 /// Writes a bag. Message times in the bag are the events' times (a scan's end), so that the bag's
 /// own order is the order in which the data become available.
 class BagWriter {
@@ -69,6 +76,10 @@ class BagWriter {
   /// the cloud must carry rings and columns); without, it is a flat list of the points.
   void writeScan(const std::string& topic, const std::string& frame_id, const Scan& scan,
                  std::optional<ScanGrid> grid = std::nullopt);
+  /// A scan as a flat sensor_msgs/PointCloud2 in another driver's layout; the header stamp is
+  /// t_start_s, the message time t_end_s.
+  void writeScanAs(ScanLayout layout, const std::string& topic, const std::string& frame_id,
+                   const Scan& scan);
   void writeImu(const std::string& topic, const std::string& frame_id, const ImuSample& imu);
   void writeGnss(const std::string& topic, const std::string& frame_id, const GnssFix& fix);
   /// Writes the index and closes the file; also done by the destructor.

@@ -102,7 +102,7 @@ struct LidarParams {
   /// An Ouster metadata JSON (beam angles, frames) instead of the built-in model; a file that
   /// cannot be read is an error.
   std::string metadata_json;
-  int beams = 128;            ///< rows; fewer than the table's: evenly subsampled
+  int beams = 0;              ///< rows; fewer than the table's: evenly subsampled; 0: all
   int columns = 1024;         ///< firings per rotation (512, 1024, 2048)
   double rotation_hz = 10.0;  ///< frames per second
   double min_range_m = 0.5;     ///< closer returns are suppressed (operator, stick)
@@ -191,6 +191,19 @@ struct RigErrorParams {
   double lidar_clock_drift_ppm = 0.0;  ///< the lidar clock runs fast against the IMU's, ppm
 };
 
+/// What the recording holds, for the kinds of recordings users have (docs/simulator.md,
+/// "Kinds of recordings").
+struct OutputParams {
+  /// `ouster`: the Ouster driver's organized cloud with per-point `t`; `velodyne`: a flat cloud
+  /// with `ring` and `time` (velodyne_pointcloud); `deskewed`: a flat x y z intensity cloud
+  /// already deskewed (with the true motion) into the lidar frame at the header stamp, the
+  /// scan's start, without a time field.
+  std::string point_layout = "ouster";
+  int scan_stride = 1;  ///< keep every n-th scan (5: a 2 Hz keyframe sequence from a 10 Hz lidar)
+  bool imu = true;      ///< write the IMU topic
+  bool gnss = true;     ///< write the GNSS topic
+};
+
 struct Scenario {
   std::string name = "mixed";
   /// The realism preset the errors came from (`ideal`, `typical`, `harsh`; realism.hpp); the
@@ -203,6 +216,7 @@ struct Scenario {
   ImuParams imu;
   GnssParams gnss;
   RigErrorParams rig;
+  OutputParams output;
 };
 
 /// The scenarios `taiga simulate --scenario` knows (canonical names).

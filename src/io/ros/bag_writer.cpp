@@ -24,6 +24,23 @@ struct OusterRecord {
 };
 static_assert(sizeof(OusterRecord) == 24);
 
+// The Velodyne driver's point record (velodyne_pointcloud PointXYZIRT, packed).
+struct VelodyneRecord {
+  float x, y, z;
+  float intensity;
+  std::uint16_t ring;
+  std::uint16_t padding;
+  float time_s;  // after the header stamp
+};
+static_assert(sizeof(VelodyneRecord) == 24);
+
+// A deskewed cloud as odometry front ends republish it: no time, no ring.
+struct XyziRecord {
+  float x, y, z;
+  float intensity;
+};
+static_assert(sizeof(XyziRecord) == 16);
+
 void addField(detail::RosPointCloud2& msg, const char* name, std::uint32_t offset, std::uint8_t datatype) {
   detail::RosPointField field;
   field.name = name;
@@ -111,6 +128,45 @@ void BagWriter::writeScan(const std::string& topic, const std::string& frame_id,
       slot = std::size_t{cloud.rings[i]} * grid->columns + cloud.columns[i];
     }
     std::memcpy(msg.data.data() + slot * sizeof(OusterRecord), &r, sizeof r);
+  }
+  impl_->bag.write(topic, toRosTime(scan.t_end_s), msg);
+}
+
+void BagWriter::writeScanAs(ScanLayout layout, const std::string& topic,
+                            const std::string& frame_id, const Scan& scan) {
+  const PointCloud& cloud = scan.cloud_in_lidar;
+  const bool timed = layout == ScanLayout::kVelodyne;
+  if (timed && !cloud.hasTimes())
+    throw std::invalid_argument("BagWriter::writeScanAs: the cloud has no per-point times");
+  const double stamp_s = detail::toSeconds(toRosTime(scan.t_start_s));
+  detail::RosPointCloud2 msg;
+  msg.header = header(frame_id, scan.t_start_s, impl_->seq);
+  addField(msg, "x", 0, detail::RosPointField::FLOAT32);
+  addField(msg, "y", 4, detail::RosPointField::FLOAT32);
+  addField(msg, "z", 8, detail::RosPointField::FLOAT32);
+  addField(msg, "intensity", 12, detail::RosPointField::FLOAT32);
+  if (timed) {
+    addField(msg, "ring", offsetof(VelodyneRecord, ring), detail::RosPointField::UINT16);
+    addField(msg, "time", offsetof(VelodyneRecord, time_s), detail::RosPointField::FLOAT32);
+  }
+  msg.height = 1;
+  msg.width = static_cast<std::uint32_t>(cloud.size());
+  msg.point_step = timed ? sizeof(VelodyneRecord) : sizeof(XyziRecord);
+  msg.row_step = msg.width * msg.point_step;
+  msg.is_bigendian = false;
+  msg.is_dense = true;
+  msg.data.assign(std::size_t{msg.row_step}, 0);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    VelodyneRecord r{};
+    r.x = static_cast<float>(cloud.positions[i].x());
+    r.y = static_cast<float>(cloud.positions[i].y());
+    r.z = static_cast<float>(cloud.positions[i].z());
+    r.intensity = cloud.hasIntensities() ? cloud.intensities[i] : 0.0f;
+    if (timed) {
+      r.ring = cloud.hasRings() ? cloud.rings[i] : 0;
+      r.time_s = static_cast<float>(cloud.times_s[i] - stamp_s);
+    }
+    std::memcpy(msg.data.data() + i * msg.point_step, &r, msg.point_step);
   }
   impl_->bag.write(topic, toRosTime(scan.t_end_s), msg);
 }
