@@ -23,6 +23,8 @@
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/mapping/mapper.hpp"
 #include "taiga/pipeline/run.hpp"
+#include "taiga/sim/realism.hpp"
+#include "taiga/sim/scenario_yaml.hpp"
 #include "taiga/sim/simulator.hpp"
 
 namespace taiga::pipeline {
@@ -42,31 +44,45 @@ struct ScenarioRun {
       online_evaluation;  ///< trajectory_online.tum: as published, corrections included
 };
 
+/// How the recording is made and which rig the run is told.
+struct RunSetup {
+  bool crop_machine = false;         ///< crop the harvester's machine with its per-scan boxes
+  std::string realism = "ideal";     ///< simulate --realism
+  std::string overrides;             ///< scenario fields (YAML) applied after the realism
+  std::string rig_file = "rig.yaml";  ///< as its user would write it, or rig_truth.yaml
+};
+
 // Simulates `scenario_name` with 64 of the OS0-128's beams (the same geometry, a faster test),
-// runs the odometry on it (cropping the harvester's machine with its per-scan boxes when asked)
-// and evaluates the trajectory against the ground truth.
+// runs the odometry on it with the rig `setup` names and evaluates the trajectory against the
+// ground truth.
 ScenarioRun simulateAndRun(const std::string& scenario_name, double duration_s, std::uint64_t seed,
-                           const std::filesystem::path& dir, bool crop_machine = false) {
+                           const std::filesystem::path& dir, const RunSetup& setup = {}) {
   sim::Scenario scenario = sim::scenarioByName(scenario_name);
+  sim::applyRealism(setup.realism, scenario);
+  if (!setup.overrides.empty())
+    sim::applyScenarioOverridesText(setup.overrides, "test overrides", scenario);
   scenario.lidar.beams = 64;
   const sim::Simulation simulation(scenario, duration_s, seed);
-  sim::writeSimulation(simulation, dir / "recording");
+  if (!std::filesystem::exists(dir / "recording" / "recording.bag"))
+    sim::writeSimulation(simulation, dir / "recording");
 
   SystemConfig config;
-  io::readConfigYaml(dir / "recording" / "rig.yaml", config);
+  io::readConfigYaml(dir / "recording" / setup.rig_file, config);
   validateAll(config);
-  RunOptions options{.out_dir = dir / "run", .show_progress = false};
-  if (crop_machine) options.moving_boxes_file = dir / "recording" / "machine_boxes.csv";
+  const std::filesystem::path run_dir =
+      dir / ("run_" + std::filesystem::path(setup.rig_file).stem().string());
+  RunOptions options{.out_dir = run_dir, .show_progress = false};
+  if (setup.crop_machine) options.moving_boxes_file = dir / "recording" / "machine_boxes.csv";
   ScenarioRun run;
   run.summary = runOdometry(dir / "recording" / "recording.bag", config, options);
   const Trajectory truth = io::readTum(dir / "recording" / "groundtruth.tum");
-  run.evaluation = eval::evaluate(io::readTum(dir / "run" / "trajectory.tum"), truth, {});
+  run.evaluation = eval::evaluate(io::readTum(run_dir / "trajectory.tum"), truth, {});
   run.odometry_evaluation =
-      eval::evaluate(io::readTum(dir / "run" / "trajectory_odometry.tum"), truth, {});
+      eval::evaluate(io::readTum(run_dir / "trajectory_odometry.tum"), truth, {});
   run.online_evaluation =
-      eval::evaluate(io::readTum(dir / "run" / "trajectory_online.tum"), truth, {});
+      eval::evaluate(io::readTum(run_dir / "trajectory_online.tum"), truth, {});
   // Map sharpness (issue 7): 100k points of map.las, in the truth frame by the ATE's alignment.
-  io::LasReader map(dir / "run" / "map.las");
+  io::LasReader map(run_dir / "map.las");
   const PointCloud sample = map.readStrided(std::max<std::uint64_t>(1, map.pointCount() / 100000));
   run.map_sharpness =
       eval::computeMapSharpness(sample.positions, map.pointCount(), run.evaluation.transform,
@@ -190,8 +206,8 @@ TEST(OdometryScenario, HandheldWalkWithImuOrientationStaysWithinCentimetresAndRe
   EXPECT_GT(run.summary.path_length_m, 10.0);
   EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.03);
   EXPECT_LT(run.evaluation.drift.drift_percent, 0.5);
-  EXPECT_TRUE(std::filesystem::exists(dir.path() / "run" / "map.las"));
-  EXPECT_TRUE(std::filesystem::exists(dir.path() / "run" / "summary.json"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "run_rig" / "map.las"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "run_rig" / "summary.json"));
 
   // The same recording again on one thread: the same trajectory, bit for bit.
   {
@@ -201,13 +217,13 @@ TEST(OdometryScenario, HandheldWalkWithImuOrientationStaysWithinCentimetresAndRe
     runOdometry(dir.path() / "recording" / "recording.bag", config,
                 {.out_dir = dir.path() / "rerun", .show_progress = false});
   }
-  EXPECT_EQ(readFile(dir.path() / "run" / "trajectory.tum"),
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "trajectory.tum"),
             readFile(dir.path() / "rerun" / "trajectory.tum"));
-  EXPECT_EQ(readFile(dir.path() / "run" / "trajectory_imu.tum"),
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "trajectory_imu.tum"),
             readFile(dir.path() / "rerun" / "trajectory_imu.tum"));
   // The map, exported from the keyframe store at the end of the run, too.
-  EXPECT_EQ(readFile(dir.path() / "run" / "map.las"), readFile(dir.path() / "rerun" / "map.las"));
-  EXPECT_EQ(readFile(dir.path() / "run" / "keyframes" / "poses.tum"),
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "map.las"), readFile(dir.path() / "rerun" / "map.las"));
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "keyframes" / "poses.tum"),
             readFile(dir.path() / "rerun" / "keyframes" / "poses.tum"));
 }
 
@@ -284,7 +300,7 @@ TEST(OdometryScenario, HandheldLoopOfThreeMinutes) {
             run.odometry_evaluation.ape.translation_m.rmse);
   EXPECT_LT(run.online_evaluation.ape.translation_m.max,
             0.95 * run.odometry_evaluation.ape.translation_m.max);
-  expectAFalseLoopIsRefused(dir.path() / "run");
+  expectAFalseLoopIsRefused(dir.path() / "run_rig");
 }
 
 // Issue 6: no divergence and ATE <= 15 cm through vibration bursts and long stops. The crane's
@@ -292,9 +308,63 @@ TEST(OdometryScenario, HandheldLoopOfThreeMinutes) {
 // own returns out of registration.
 TEST(OdometryScenario, HarvesterOfThreeMinutes) {
   test::TempDir dir;
-  const ScenarioRun run = simulateAndRun("harvester", 180.0, 2, dir.path(), true);
+  const ScenarioRun run = simulateAndRun("harvester", 180.0, 2, dir.path(), {.crop_machine = true});
   expectEveryScanUsed(run.summary);
   EXPECT_LE(run.summary.lidar_inflated, run.summary.scans / 20);
+  EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.15);
+  EXPECT_LT(run.evaluation.ape.translation_m.max, 0.30);
+}
+
+// Issue 18: the rig as its user would write it. With `typical` realism the recording has IMU
+// noise 2x its datasheet, wandering biases, scale and axis errors, a 2 deg / 3 cm extrinsic
+// error, a 10 ms time offset, noisier and lossier lidar returns and wind; rig.yaml states the
+// nominal rig. Measured on these 15 s walks (64 beams): ATE 5.9, 3.9, 3.8 cm and end-point drift
+// 1.4-2.3 % with rig.yaml, against 0.5-1.7 cm ideal; told the truth (rig_truth.yaml) the same
+// recordings give 0.9-1.8 cm. So the estimator copes with the sensors' errors, and the rig's
+// unstated extrinsics and time offset cost the rest (bench/realism_sources.sh measures each
+// source on its own; the self-calibration issue is to remove it).
+TEST(OdometryScenario, TypicalRealismWithTheRigAUserWouldWriteOnThreeSeeds) {
+  for (const std::uint64_t seed : {1, 2, 3}) {
+    SCOPED_TRACE(seed);
+    test::TempDir dir;
+    const ScenarioRun stated =
+        simulateAndRun("handheld-loop", 15.0, seed, dir.path(), {.realism = "typical"});
+    expectEveryScanUsed(stated.summary);
+    EXPECT_LT(stated.evaluation.ape.translation_m.rmse, 0.10);
+    EXPECT_LT(stated.evaluation.drift.drift_percent, 4.0);
+    const ScenarioRun truth = simulateAndRun("handheld-loop", 15.0, seed, dir.path(),
+                                             {.realism = "typical", .rig_file = "rig_truth.yaml"});
+    expectEveryScanUsed(truth.summary);
+    EXPECT_LT(truth.evaluation.ape.translation_m.rmse, 0.03);
+    EXPECT_LT(truth.evaluation.ape.translation_m.rmse, stated.evaluation.ape.translation_m.rmse);
+  }
+}
+
+// Deliberately wrong settings, the others ideal: the true IMU noise and bias walks 3x what
+// rig.yaml says, its T_body_lidar 2 deg and 3 cm off, and a 10 ms lidar-IMU time offset it
+// does not state. Measured: ATE 6.6, 4.4, 4.2 cm on these 15 s walks; no scan is lost.
+TEST(OdometryScenario, DeliberatelyWrongSettingsOnThreeSeeds) {
+  for (const std::uint64_t seed : {1, 2, 3}) {
+    SCOPED_TRACE(seed);
+    test::TempDir dir;
+    const ScenarioRun run = simulateAndRun(
+        "handheld-loop", 15.0, seed, dir.path(),
+        {.overrides = "imu: {noise_density_factor: 3, bias_walk_factor: 3}\n"
+                      "rig: {extrinsic_rotation_error_deg: 2, extrinsic_translation_error_m: "
+                      "0.03, lidar_time_offset_s: 0.010}\n"});
+    expectEveryScanUsed(run.summary);
+    EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.11);
+    EXPECT_LT(run.evaluation.drift.drift_percent, 4.0);
+  }
+}
+
+// The harvester with `typical` realism and the rig a user would write: vibration through an
+// IMU 2x noisier than its datasheet with scale errors and clipping at 4 g, the crane cropped.
+TEST(OdometryScenario, HarvesterWithTypicalRealism) {
+  test::TempDir dir;
+  const ScenarioRun run = simulateAndRun("harvester", 90.0, 3, dir.path(),
+                                         {.crop_machine = true, .realism = "typical"});
+  expectEveryScanUsed(run.summary);
   EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.15);
   EXPECT_LT(run.evaluation.ape.translation_m.max, 0.30);
 }
