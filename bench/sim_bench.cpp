@@ -12,9 +12,12 @@
 // depends on what else runs, while CPU-seconds per data-second is what real time needs on an idle
 // machine (<= 1 at one thread, <= 2 at two threads with perfect scaling).
 //
-//   sim_bench [RUNS] [DURATION_S] [SCENARIO] [SEED] [SUB_RAYS]
-//     (defaults 3, 10, mixed, 1, the scenario's 4; run from the repository root: the simulator
-//      reads ../shared/data/ouster)
+//   sim_bench [RUNS] [DURATION_S] [SCENARIO] [SEED] [SUB_RAYS] [REALISM,REALISM...]
+//     (defaults 3, 10, mixed, 1, the scenario's 4; the beam table is built in)
+//
+// With a list of realism presets (e.g. `ideal,typical`), it compares them instead: per run, the
+// whole simulation at 2 threads for each preset in turn (interleaved, so that the machine's load
+// falls on all alike), and the median wall and CPU time of each as a ratio to the first.
 #include <sys/resource.h>
 #include <tbb/task_arena.h>
 
@@ -26,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "taiga/sim/realism.hpp"
 #include "taiga/sim/simulator.hpp"
 
 namespace {
@@ -60,6 +64,56 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    out.push_back(list.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return out;
+}
+
+int compareRealism(const std::vector<std::string>& presets, int runs, double duration_s,
+                   const std::string& scenario_name, std::uint64_t seed) {
+  std::vector<std::unique_ptr<taiga::sim::Simulation>> simulations;
+  for (const std::string& preset : presets) {
+    taiga::sim::Scenario scenario = taiga::sim::scenarioByName(scenario_name);
+    taiga::sim::applyRealism(preset, scenario);
+    simulations.push_back(std::make_unique<taiga::sim::Simulation>(scenario, duration_s, seed));
+  }
+  const double data_s =
+      static_cast<double>(simulations[0]->scanCount()) * simulations[0]->lidar().scanPeriod_s();
+  const std::filesystem::path out_dir =
+      std::filesystem::temp_directory_path() / ("taiga_sim_bench_" + std::to_string(getpid()));
+  std::vector<std::vector<double>> wall(presets.size()), cpu(presets.size());
+  tbb::task_arena arena(2);
+  for (int run = 0; run < runs; ++run) {
+    for (std::size_t i = 0; i < presets.size(); ++i) {
+      const Timing t =
+          timed([&] { arena.execute([&] { taiga::sim::writeSimulation(*simulations[i], out_dir); }); });
+      wall[i].push_back(t.wall_s);
+      cpu[i].push_back(t.cpu_s);
+    }
+  }
+  std::filesystem::remove_all(out_dir);
+  std::printf("scenario %s, seed %llu, %.1f s of data, whole simulation at 2 threads, %d runs
+
+"
+              "| realism | wall s (median) | data s / wall s | CPU s / data s | wall ratio | CPU ratio |
+"
+              "|---|---|---|---|---|---|
+",
+              scenario_name.c_str(), static_cast<unsigned long long>(seed), data_s, runs);
+  for (std::size_t i = 0; i < presets.size(); ++i) {
+    const double w = median(wall[i]), c = median(cpu[i]);
+    std::printf("| %s | %.2f | %.2f | %.2f | %.3f | %.3f |\n", presets[i].c_str(), w, data_s / w,
+                c / data_s, w / median(wall[0]), c / median(cpu[0]));
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -73,6 +127,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  if (argc > 6) return compareRealism(split(argv[6]), runs, duration_s, scenario_name, seed);
   taiga::sim::Scenario scenario = taiga::sim::scenarioByName(scenario_name);
   if (argc > 5) scenario.lidar.sub_rays = std::atoi(argv[5]);
   std::unique_ptr<taiga::sim::Simulation> simulation;
