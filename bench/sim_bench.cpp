@@ -98,13 +98,10 @@ int compareRealism(const std::vector<std::string>& presets, int runs, double dur
     }
   }
   std::filesystem::remove_all(out_dir);
-  std::printf("scenario %s, seed %llu, %.1f s of data, whole simulation at 2 threads, %d runs
-
-"
-              "| realism | wall s (median) | data s / wall s | CPU s / data s | wall ratio | CPU ratio |
-"
-              "|---|---|---|---|---|---|
-",
+  std::printf(
+      "scenario %s, seed %llu, %.1f s of data, whole simulation at 2 threads, %d runs\n\n"
+      "| realism | wall s (median) | data s / wall s | CPU s / data s | wall ratio | CPU ratio |\n"
+      "|---|---|---|---|---|---|\n",
               scenario_name.c_str(), static_cast<unsigned long long>(seed), data_s, runs);
   for (std::size_t i = 0; i < presets.size(); ++i) {
     const double w = median(wall[i]), c = median(cpu[i]);
