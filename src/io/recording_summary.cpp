@@ -90,7 +90,7 @@ void addWarnings(RecordingSummary& s, const std::vector<std::size_t>& points_per
     }
   }
   if (!lidar || lidar->count == 0) s.warnings.push_back("no scans");
-  if (!imu || imu->count == 0) s.warnings.push_back("no IMU samples: taiga run needs an IMU");
+  if (!imu || imu->count == 0) s.warnings.push_back("no IMU samples: taiga run falls back to lidar-only odometry (odometry.imu_use: auto)");
   if (lidar && imu && lidar->count > 0 && imu->count > 0) {
     // Scans are listed by their start; the last one lasts until its last point.
     const double lidar_end_s = lidar->last_s + s.scans.median_span_s;

@@ -192,7 +192,7 @@ io::Scan LidarSimulator::simulateScan(const Scene& scene, const WalkingMotion& m
             centers[pixel] = {hit->range_m, 1.0, reflectivity(hit->material) * cos_inc};
             solid[pixel] = hit->material != Material::kFoliage ? 1 : 0;
             segment[pixel] = hit->curve_segment;
-            if (wind) {
+            if (wind && Wind::sways(hit->material)) {
               const Eigen::Vector3d p = c.origin_world + hit->range_m * dirs[row];
               sway_gain[pixel] = static_cast<float>(Wind::gain(
                   hit->material, p.z() - scene.terrain().smoothHeight(p.x(), p.y())));

@@ -21,6 +21,11 @@ Wind::Wind(const ForestParams& params, std::uint64_t seed)
   direction_world_ = Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth), 0.0);
 }
 
+bool Wind::sways(Material material) {
+  return material == Material::kBark || material == Material::kBranch ||
+         material == Material::kFoliage;
+}
+
 double Wind::gain(Material material, double height_above_ground_m) {
   double factor = 0.0;
   if (material == Material::kBark) factor = 1.0;

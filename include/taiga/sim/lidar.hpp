@@ -11,8 +11,9 @@
 //
 // Modelled: beam divergence with sub-rays (mixed returns at edges: a partly hit stem pulls the
 // range of its background, or is returned alone when nothing is behind it), range noise growing
-// with range, maximum range from reflectivity and incidence, random dropouts, calibrated
-// reflectivity as intensity. Not modelled: multiple returns, range-dependent intensity,
+// with range (and, with realism, with weakness of the return), maximum range from reflectivity
+// and incidence, random dropouts, lost packets of 16 columns, surfaces swaying in the wind
+// (wind.hpp), calibrated reflectivity as intensity. Not modelled: multiple returns, range-dependent intensity,
 // blooming from retro-reflectors, the operator's own body occluding the view.
 
 #include <cstdint>

@@ -25,6 +25,8 @@ class Wind {
   Wind(const ForestParams& params, std::uint64_t seed);
 
   bool calm() const { return amplitude_m_ <= 0.0; }
+  /// Whether a surface of that material moves at all (bark, branches, foliage).
+  static bool sways(Material material);
   /// Gain g of a surface of that material at that height above the ground (0: it stays).
   static double gain(Material material, double height_above_ground_m);
   /// Horizontal sway of a surface of gain 1 at p_world and motion time t, m.
