@@ -35,6 +35,25 @@ void useOneMallocArena() {
 #endif
 }
 
+// The health monitor's verdict; the first lost stretch with its reason, since that is where a
+// user looks first.
+void printHealth(const pipeline::HealthReport& h) {
+  fmt::print("health     {}: {} scans ok, {} degraded, {} lost; {} map segment{}\n", h.verdict(),
+             h.ok, h.degraded, h.lost, h.map_segments, h.map_segments == 1 ? "" : "s");
+  constexpr int kListed = 5;  // summary.json has them all
+  int listed = 0;
+  for (const pipeline::HealthStretch& stretch : h.stretches) {
+    if (stretch.status != "lost") continue;
+    if (listed++ == kListed) break;
+    fmt::print("           lost {:.1f}..{:.1f} s ({} scans): {}\n", stretch.from_s, stretch.to_s,
+               stretch.scans, stretch.reason);
+  }
+  if (h.trackLost())
+    fmt::print(
+        "           the track was lost and not re-attached: the trajectory and map after it are "
+        "not tied to those before it (scans.csv marks every scan; exit code 3)\n");
+}
+
 int run(const RunOptions& options) {
   useOneMallocArena();
   SystemConfig config = loadConfig(options.config);
@@ -50,6 +69,7 @@ int run(const RunOptions& options) {
              s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
   fmt::print("lidar      lidar factors {} rejected, {} inflated; {} keyframes, {} map points\n",
              s.lidar_rejected, s.lidar_inflated, s.keyframes, s.map_points);
+  printHealth(s.health);
   fmt::print(
       "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {:.2f}x real time; peak "
       "memory {:.0f} MB\n",
@@ -79,7 +99,7 @@ int run(const RunOptions& options) {
       "keyframes/, map.las{}, loops.csv, timing.csv, scans.csv, summary.json{})\n",
       options.out, options.ply ? ", map.ply" : "",
       s.georef && s.georef->skipped.empty() ? ", georef/" : "");
-  return kExitOk;
+  return s.health.trackLost() ? kExitTrackLost : kExitOk;
 }
 
 }  // namespace

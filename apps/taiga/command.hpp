@@ -14,6 +14,9 @@ enum ExitCode : int {
   kExitOk = 0,
   kExitFailure = 1,          ///< the work itself failed (e.g. a run diverged)
   kExitBadInput = 2,         ///< bad command line, file or configuration; the message says which
+  /// taiga run finished and wrote every output, but lost track and did not re-attach to the
+  /// map (summary.json health); taiga register's answer is not to be trusted (--strict)
+  kExitTrackLost = 3,
   kExitNotImplemented = 69,  ///< the subcommand exists in the contract but is not built yet
   kExitInternalError = 70,   ///< a bug in taiga; please report it with the message
 };

@@ -24,6 +24,47 @@ void ImuNoiseConfig::validate() const {
   requireInRange("gravity_mps2", gravity_mps2, 9.7, 9.9, "m/s^2");
 }
 
+void HealthConfig::visit(ConfigVisitor& v) {
+  v.field("lost_after_s", lost_after_s,
+          "s without a scan judged ok (dead reckoning only) after which the track is lost");
+  v.field("lost_after_scans", lost_after_scans,
+          "scans in a row not ok that also need to pass before the track is lost");
+  v.field("reinitialize_after_s", reinitialize_after_s,
+          "s lost beyond lost_after_s after which the local map starts over from the next scan");
+  v.field("recovery_scans", recovery_scans, "scans judged ok in a row that end a lost stretch");
+  v.field("history_scans", history_scans,
+          "recent scans with a used lidar factor whose median fitness and inlier share are the "
+          "yardstick");
+  v.field("fitness_ratio", fitness_ratio,
+          "a scan whose fitness is above this many times the recent median is degraded");
+  v.field("fitness_floor_m2", fitness_floor_m2,
+          "m^2, fitness below this is never degraded (noise level)");
+  v.field("inlier_share_ratio", inlier_share_ratio,
+          "a scan whose inlier share is below this fraction of the recent median is degraded");
+  v.field("max_speed_mps", max_speed_mps, "m/s, a faster estimate means the track is lost");
+  v.field("max_acceleration_mps2", max_acceleration_mps2,
+          "m/s^2, a faster change of the estimated velocity between scans is degraded");
+  v.field("max_accel_bias_mps2", max_accel_bias_mps2,
+          "m/s^2, an accelerometer bias estimate beyond this is implausible: degraded");
+  v.field("max_gyro_bias_dps", max_gyro_bias_dps,
+          "deg/s, a gyroscope bias estimate beyond this is implausible: degraded");
+}
+
+void HealthConfig::validate() const {
+  requireInRange("lost_after_s", lost_after_s, 0.05, 60.0, "s");
+  requireInRange("lost_after_scans", lost_after_scans, 1, 1000, "scans");
+  requireInRange("reinitialize_after_s", reinitialize_after_s, 0.0, 3600.0, "s");
+  requireInRange("recovery_scans", recovery_scans, 1, 1000, "scans");
+  requireInRange("history_scans", history_scans, 3, 10000, "scans");
+  requireInRange("fitness_ratio", fitness_ratio, 1.0, 1000.0, "");
+  requireNonNegative("fitness_floor_m2", fitness_floor_m2, "m^2");
+  requireInRange("inlier_share_ratio", inlier_share_ratio, 0.0, 1.0, "");
+  requirePositive("max_speed_mps", max_speed_mps, "m/s");
+  requirePositive("max_acceleration_mps2", max_acceleration_mps2, "m/s^2");
+  requirePositive("max_accel_bias_mps2", max_accel_bias_mps2, "m/s^2");
+  requirePositive("max_gyro_bias_dps", max_gyro_bias_dps, "deg/s");
+}
+
 void OdometryConfig::visit(ConfigVisitor& v) {
   v.field("min_range_m", min_range_m, "m, returns closer to the lidar are dropped (operator, rig)");
   v.field("max_range_m", max_range_m, "m, returns farther from the lidar are dropped");
@@ -72,6 +113,8 @@ void OdometryConfig::visit(ConfigVisitor& v) {
           "s, span of the first scans used to level the world frame with lidar and IMU (0: IMU "
           "attitude only)");
   v.section("imu", imu, "IMU noise model");
+  v.section("health", health,
+            "when a scan is degraded or the track lost (docs/odometry.md, Health)");
 }
 
 LidarSigmas OdometryConfig::lidarSigmas(double fitness_m2, double inflation) const {

@@ -46,9 +46,14 @@ Progress::Progress(std::string label, std::size_t total, std::string unit, std::
 Progress::~Progress() { finish(); }
 
 void Progress::update(std::size_t done) {
-  done_ = std::min(done, total_);
+  done_ = total_ == 0 ? done : std::min(done, total_);  // total 0: unknown
   if (!enabled_ || finished_) return;
   if (Clock::now() - last_draw_ >= std::chrono::milliseconds(200)) draw();
+}
+
+void Progress::update(std::size_t done, std::string note) {
+  note_ = std::move(note);
+  update(done);
 }
 
 void Progress::finish() {
@@ -64,8 +69,9 @@ void Progress::draw() {
   last_draw_ = Clock::now();
   const double elapsed_s = std::chrono::duration<double>(last_draw_ - start_).count();
   // \r returns to the line start, \033[K clears what a longer previous line left behind.
-  std::fprintf(out_, "\r%s\033[K",
-               formatProgressLine(label_, done_, total_, unit_, elapsed_s).c_str());
+  std::string line = formatProgressLine(label_, done_, total_, unit_, elapsed_s);
+  if (!note_.empty()) line += "  [" + note_ + "]";
+  std::fprintf(out_, "\r%s\033[K", line.c_str());
   std::fflush(out_);
 }
 

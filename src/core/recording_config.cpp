@@ -10,6 +10,9 @@ void RecordingConfig::visit(ConfigVisitor& v) {
   v.field("scan_period_s", scan_period_s, "s, one lidar sweep; used only to derive missing point times");
   v.field("point_time_field", point_time_field,
           "point field with per-point time; empty: t, time, offset_time or timestamp");
+  v.field("deskewed", deskewed,
+          "true: the clouds were deskewed upstream into the lidar frame at the message stamp; "
+          "every point is taken at the stamp and not deskewed again");
 }
 
 void RecordingConfig::validate() const {

@@ -2,20 +2,55 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "taiga/core/errors.hpp"
+#include "taiga/core/percentile.hpp"
 
 namespace taiga::eval {
+namespace {
+
+/// The --t-offset (added to the estimate's stamps, as evo's) that would make the stamps match:
+/// the start difference when the spans do not overlap, then the median gap from each estimate
+/// stamp to its nearest reference stamp (e.g. half a scan when one is stamped at scan start and
+/// the other at scan end).
+double suggestedTimeOffset(const Trajectory& est, const Trajectory& ref) {
+  const bool overlap = est.startTime() <= ref.endTime() && ref.startTime() <= est.endTime();
+  const double shift_s = overlap ? 0.0 : ref.startTime() - est.startTime();
+  std::vector<double> ref_s;
+  for (const StampedPose& p : ref.poses()) ref_s.push_back(p.t_s);
+  std::vector<double> gaps_s;
+  for (const StampedPose& p : est.poses()) {
+    const double t_s = p.t_s + shift_s;
+    const auto upper = std::lower_bound(ref_s.begin(), ref_s.end(), t_s);
+    double gap_s = upper == ref_s.end() ? ref_s.back() - t_s : *upper - t_s;
+    if (upper != ref_s.begin() && std::abs(*(upper - 1) - t_s) < std::abs(gap_s))
+      gap_s = *(upper - 1) - t_s;
+    gaps_s.push_back(gap_s);
+  }
+  return shift_s + percentile(gaps_s, 50.0);
+}
+
+}  // namespace
 
 EvalResult evaluate(const Trajectory& est, const Trajectory& ref, const EvalOptions& options) {
   EvalResult r;
   r.est_count = est.size();
   r.ref_count = ref.size();
   r.pairs = associate(est, ref, options.association);
+  if (r.pairs.size() == 0 && (est.empty() || ref.empty()))
+    throw InputError(fmt::format("nothing to evaluate: the estimate has {} poses, the reference {}",
+                                 est.size(), ref.size()));
   if (r.pairs.size() == 0)
     throw InputError(fmt::format(
-        "no matching time stamps between the estimate ({} poses) and the reference ({} poses) "
-        "with --t-max-diff {} s and --t-offset {} s",
-        est.size(), ref.size(), options.association.t_max_diff_s, options.association.t_offset_s));
+        "no matching time stamps between the estimate ({} poses, {:.3f} .. {:.3f} s) and the "
+        "reference ({} poses, {:.3f} .. {:.3f} s) with --t-max-diff {} s and --t-offset {} s; "
+        "--t-offset {:.6f} would make them match (taiga's trajectories are stamped at the scan's "
+        "end)",
+        est.size(), est.startTime(), est.endTime(), ref.size(), ref.startTime(), ref.endTime(),
+        options.association.t_max_diff_s, options.association.t_offset_s,
+        suggestedTimeOffset(est, ref)));
   r.alignment = options.alignment;
   r.transform = computeAlignment(r.pairs.est, r.pairs.ref, options.alignment);
   r.est_aligned = applyAlignment(r.pairs.est, r.transform);

@@ -29,7 +29,7 @@ std::optional<double> stampFromName(const std::filesystem::path& file) {
 class FolderScanStream final : public StreamSource {
  public:
   FolderScanStream(std::vector<FolderScanFile> files, const RecordingConfig& config)
-      : files_(std::move(files)), options_{config.scan_period_s, config.point_time_field} {}
+      : files_(std::move(files)), options_{config.scan_period_s, config.point_time_field, config.deskewed} {}
 
   std::string name() const override { return "scans/"; }
   std::vector<std::string> details() const override { return details_; }
@@ -41,9 +41,10 @@ class FolderScanStream final : public StreamSource {
       if (!reported_times_) {
         reported_times_ = true;
         details_ = {fmt::format("{} scan files", files_.size()), fmt::format("per-point times: {}", decoded.time_description)};
-        const bool guessed = decoded.time_source == PointTimeSource::kAzimuth || decoded.time_source == PointTimeSource::kColumnIndex;
-        logger().log(guessed ? spdlog::level::warn : spdlog::level::info, "{}: per-point times: {}",
-                     file.path.parent_path().string(), decoded.time_description);
+        const bool guessed = timesInvented(decoded.time_source);
+        logger().log(guessed ? spdlog::level::warn : spdlog::level::info, "{}: per-point times: {}{}",
+                     file.path.parent_path().string(), decoded.time_description,
+                     guessed ? " (clouds deskewed upstream: recording.deskewed: true)" : "");
       }
       if (decoded.cloud.empty()) {
         logger().warn("{}: no valid point; skipped", file.path.string());
@@ -53,6 +54,7 @@ class FolderScanStream final : public StreamSource {
       scan.index = scan_count_++;
       std::tie(scan.t_start_s, scan.t_end_s) = decoded.cloud.timeSpan();
       scan.cloud_in_lidar = std::move(decoded.cloud);
+      scan.times_invented = timesInvented(decoded.time_source);
       return scan;
     }
     return std::nullopt;

@@ -248,7 +248,9 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
         continue;
       }
       double t_s = stamp_s;
-      if (time_rule.field) {
+      if (options.deskewed) {
+        // every point at the stamp
+      } else if (time_rule.field) {
         const double value = unpackValue(record + time_rule.field->offset, time_rule.field->type, swap);
         if (time_rule.absolute) {
           if (absolute_scale == 0.0) absolute_scale = absoluteScale(std::abs(value));
@@ -279,7 +281,10 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
     }
   }
 
-  if (time_rule.field) {
+  if (options.deskewed) {
+    out.time_source = PointTimeSource::kStamp;
+    out.time_description = "deskewed upstream (recording.deskewed): every point at the stamp";
+  } else if (time_rule.field) {
     out.time_source = time_rule.absolute ? PointTimeSource::kAbsoluteField : PointTimeSource::kRelativeField;
     out.time_description = time_rule.description;
     if (time_rule.absolute) {

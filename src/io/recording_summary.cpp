@@ -78,7 +78,7 @@ std::string formatFromPath(const std::filesystem::path& path) {
   return "unknown";
 }
 
-void addWarnings(RecordingSummary& s, const std::vector<std::size_t>& points_per_scan) {
+void addWarnings(RecordingSummary& s, const std::vector<std::size_t>& points_per_scan, bool deskewed) {
   const StreamStats* lidar = nullptr;
   const StreamStats* imu = nullptr;
   for (const StreamStats& st : s.streams) {
@@ -102,7 +102,12 @@ void addWarnings(RecordingSummary& s, const std::vector<std::size_t>& points_per
       s.warnings.push_back(fmt::format("the lidar and IMU streams start {:.3f} s apart", lidar->first_s - imu->first_s));
     }
   }
-  if (lidar && lidar->count >= 2 && lidar->median_interval_s > 0) {
+  if (s.scans.scans_with_invented_times > 0) {
+    s.warnings.push_back(fmt::format("{} of {} scans have no per-point time field: taiga invents times from the geometry over "
+                                     "recording.scan_period_s and deskews with them; if the clouds were deskewed upstream, set "
+                                     "recording.deskewed: true",
+                                     s.scans.scans_with_invented_times, points_per_scan.size()));
+  } else if (lidar && lidar->count >= 2 && lidar->median_interval_s > 0 && !deskewed) {
     const double ratio = s.scans.median_span_s / lidar->median_interval_s;
     if (ratio < 0.5 || ratio > 1.1) {
       s.warnings.push_back(fmt::format("per-point times span {:.4f} s per scan (median) but scans come every {:.4f} s: a "
@@ -158,6 +163,7 @@ RecordingSummary summarizeRecording(const std::filesystem::path& path, const Rec
         points_per_scan.push_back(cloud.size());
         spans.push_back(scan->t_end_s - scan->t_start_s);
         if (timesIncreaseAcrossScan(cloud)) ++s.scans.scans_with_monotonic_times;
+        s.scans.scans_with_invented_times += scan->times_invented;
         s.scans.has_columns |= cloud.hasColumns();
         s.scans.has_rings |= cloud.hasRings();
         s.scans.has_intensities |= cloud.hasIntensities();
@@ -209,7 +215,7 @@ RecordingSummary summarizeRecording(const std::filesystem::path& path, const Rec
   if (!sigmas.empty()) s.gnss.median_horizontal_sigma_m = median(sigmas);
   s.repairs = recording.repairs();
   s.details = recording.streamDetails();
-  addWarnings(s, points_per_scan);
+  addWarnings(s, points_per_scan, recording_config.deskewed);
   return s;
 }
 
@@ -270,6 +276,7 @@ std::string formatSummaryJson(const RecordingSummary& s) {
                 {"max_points", s.scans.max_points},
                 {"median_span_s", s.scans.median_span_s},
                 {"scans_with_monotonic_times", s.scans.scans_with_monotonic_times},
+                {"scans_with_invented_times", s.scans.scans_with_invented_times},
                 {"has_rings", s.scans.has_rings},
                 {"has_columns", s.scans.has_columns},
                 {"has_intensities", s.scans.has_intensities}};

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "taiga/core/angles.hpp"
@@ -21,6 +22,30 @@ std::string rejection(const registration::RegistrationResult& r,
   if (check_jump && (jump_m > config.max_jump_m || jump_deg > config.max_jump_deg))
     return fmt::format("{:.3f} m / {:.2f} deg from the IMU prediction", jump_m, jump_deg);
   return {};
+}
+
+/// Solution remapping (Zhang, Kaess and Singh 2016, "On degeneracy of optimization-based state
+/// estimation problems"): the registration's step away from the prediction is kept along the
+/// Hessian's eigenvectors that the scan constrains and dropped along those it does not
+/// (eigenvalue below the largest / max_condition), where the prediction stands. `dropped` gets
+/// the number of directions dropped.
+lie::SE3 keepConstrainedDirections(const lie::SE3& predicted_T_odom_body,
+                                   const registration::RegistrationResult& r,
+                                   double max_condition, int& dropped) {
+  const Eigen::SelfAdjointEigenSolver<lie::Matrix6> eigen(r.hessian);
+  const lie::Vector6 step = (predicted_T_odom_body.inverse() * r.T_target_source).Log();
+  const double floor = eigen.eigenvalues().maxCoeff() / max_condition;
+  lie::Vector6 kept = lie::Vector6::Zero();
+  dropped = 0;
+  for (int i = 0; i < 6; ++i) {
+    const lie::Vector6 direction = eigen.eigenvectors().col(i);
+    if (eigen.eigenvalues()(i) > floor) {
+      kept += direction * direction.dot(step);
+    } else {
+      ++dropped;
+    }
+  }
+  return predicted_T_odom_body * lie::SE3::Exp(kept);
 }
 
 }  // namespace
@@ -46,8 +71,19 @@ LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
   // factor would hold on to a tilted local map. Heading has no such second source, so it gets its
   // own, tighter sigma (docs/odometry.md). The factor's rotation tangent is in the body frame:
   // Sigma_body = R^T Sigma_odom R.
+  lie::SE3 T_odom_body = r.T_target_source;
+  if (!check_jump && r.hessian_condition > config.degenerate_condition &&
+      std::isfinite(r.hessian_condition)) {
+    // Without an IMU the prediction is a constant velocity and the measurement is taken as the
+    // state whatever its covariance: the degenerate directions keep the prediction instead.
+    int dropped = 0;
+    T_odom_body = keepConstrainedDirections(predicted_T_odom_body, r,
+                                            config.degenerate_condition, dropped);
+    verdict.note += fmt::format("; the prediction kept along {} direction{}", dropped,
+                                dropped == 1 ? "" : "s");
+  }
   const LidarSigmas sigma = config.lidarSigmas(r.fitness_m2, inflation);
-  const Eigen::Matrix3d R_odom_body = r.T_target_source.rotation().matrix();
+  const Eigen::Matrix3d R_odom_body = T_odom_body.rotation().matrix();
   const Eigen::Vector3d rotation_variances_odom(sigma.tilt_rad * sigma.tilt_rad,
                                                 sigma.tilt_rad * sigma.tilt_rad,
                                                 sigma.heading_rad * sigma.heading_rad);
@@ -56,7 +92,7 @@ LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
       Eigen::Matrix3d::Identity() * sigma.translation_m * sigma.translation_m;
   covariance.bottomRightCorner<3, 3>() =
       R_odom_body.transpose() * rotation_variances_odom.asDiagonal() * R_odom_body;
-  verdict.measurement = backend::PoseMeasurement{r.T_target_source, covariance};
+  verdict.measurement = backend::PoseMeasurement{T_odom_body, covariance};
   return verdict;
 }
 

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "health_monitor.hpp"
 #include "lidar_factor.hpp"
 #include "motion_prior.hpp"
 #include "scan_preparation.hpp"
@@ -51,7 +52,8 @@ Odometry::Odometry(const OdometryConfig& config, const RigConfig& rig, bool lida
       local_map_(localMapResolutionsM(config, lidar_only), config.local_map_voxel_m,
                  config.local_map_keyframes,
                  registration_.method == registration::Method::kGicp ? LocalMap::Target::kGicp
-                                                                     : LocalMap::Target::kNdt) {}
+                                                                     : LocalMap::Target::kNdt),
+      health_(std::make_unique<HealthMonitor>(config.health, config.fitness_threshold_m2)) {}
 
 Odometry::~Odometry() = default;
 
@@ -83,6 +85,7 @@ ScanOutcome Odometry::firstScanOutcome(FirstScan&& first) {
   outcome.v_odom = first.state.v_odom;
   outcome.bias = first.state.bias;
   outcome.lidar = LidarFactor::kFirstScan;
+  judgeHealth(outcome, false);
   maybeAddKeyframe(outcome, first.cloud_in_body);
   return outcome;
 }
@@ -134,13 +137,15 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
     // local map starts over from this scan, deskewed with the velocity the odometry has found.
     local_map_.clear();
     last_keyframe_T_odom_body_.reset();
+    health_->forgetHistory();
     for (StampedPose& p : outcome.imu_rate_poses) p.pose = *update.T_odom_unlevelled * p.pose;
     outcome.T_odom_unlevelled = update.T_odom_unlevelled;
   }
   outcome.timing.optimization_ms = msSince(stage);
 
-  // 7. Keyframe.
+  // 7. Health; 8. keyframe.
   stage = Clock::now();
+  judgeHealth(outcome, has_map);
   maybeAddKeyframe(outcome, cloud_in_body);
   outcome.timing.map_ms = msSince(stage);
   outcome.timing.total_ms = msSince(start);
@@ -174,7 +179,37 @@ registration::RegistrationResult Odometry::registerToMap(const std::vector<Eigen
   return result;
 }
 
+void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
+  const registration::RegistrationResult& r = outcome.registration;
+  outcome.health = health_->judge(
+      {.t_s = outcome.t_s,
+       .registered = registered,
+       .lidar = outcome.lidar,
+       .lidar_note = outcome.lidar_note,
+       .fitness_m2 = r.fitness_m2,
+       .inlier_share = outcome.source_points > 0 ? static_cast<double>(r.num_inliers) /
+                                                       static_cast<double>(outcome.source_points)
+                                                 : 0.0,
+       .v_odom = outcome.v_odom,
+       .bias = outcome.bias,
+       .estimates_bias = !lidar_only_});
+  if (health_->restartLocalMap()) {
+    // Lost for long: the old local map no longer explains the scans. A new segment starts with
+    // this scan, placed by dead reckoning (docs/odometry.md, "Health").
+    local_map_.clear();
+    last_keyframe_T_odom_body_.reset();
+    health_->localMapRestarted();
+    ++map_segment_;
+    logger().warn("scan {} at {:.3f} s: lost for long, the local map starts over (segment {})",
+                  outcome.scan_index, outcome.t_s, map_segment_);
+  }
+  outcome.map_segment = map_segment_;
+}
+
 void Odometry::maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body) {
+  // A scan the monitor distrusts never enters the map, but an empty map takes the next scan
+  // whatever its status: there is nothing else to register to.
+  if (outcome.health.status != ScanStatus::kOk && !local_map_.empty()) return;
   if (last_keyframe_T_odom_body_) {
     const lie::Vector6 moved = (last_keyframe_T_odom_body_->inverse() * outcome.T_odom_body).Log();
     const double travelled_m =

@@ -11,6 +11,7 @@
 
 #include "recording_feed.hpp"
 #include "run_georef.hpp"
+#include "run_health.hpp"
 #include "run_outputs.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
@@ -51,24 +52,27 @@ MovingBoxes movingBoxes(const std::filesystem::path& file) {
   return boxes;
 }
 
-// Lidar-only when configured so, or (auto) when no IMU reading comes with the first 2 s of
-// scans. The events read to decide are left in `read_ahead`, to be handled first (without
-// pacing under --realtime).
+// Lidar-only when configured so, or (auto) when no IMU reading comes with the first 2 s of scans
+// (or with all of a shorter recording). The events read to decide are left in `read_ahead`, to
+// be handled first (without pacing under --realtime).
 bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
                   std::deque<io::RecordingEvent>& read_ahead) {
   bool lidar_only = imu_use == "lidar_only";
   if (imu_use == "auto") {
     constexpr double kImuWait_s = 2.0;
     std::optional<double> first_scan_s;
+    lidar_only = true;  // unless an IMU reading comes in time
     while (std::optional<io::RecordingEvent> event = recording.next()) {
       read_ahead.push_back(std::move(*event));
-      if (std::holds_alternative<ImuSample>(read_ahead.back())) break;
+      if (std::holds_alternative<ImuSample>(read_ahead.back())) {
+        lidar_only = false;
+        break;
+      }
       if (!std::holds_alternative<io::Scan>(read_ahead.back())) continue;
       const double t_s = io::eventTime(read_ahead.back());
       if (!first_scan_s) first_scan_s = t_s;
-      lidar_only = t_s - *first_scan_s >= kImuWait_s;
-      if (lidar_only) break;
-    }  // too short to tell: lidar-inertial, and the odometry will say what it lacks
+      if (t_s - *first_scan_s >= kImuWait_s) break;
+    }
   }
   if (lidar_only)
     logger().info(
@@ -83,7 +87,7 @@ bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
 /// Returns the scans read and, under --realtime, what a live run would have seen.
 std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEvent> read_ahead,
                           const RunOptions& options, SlamSystem& slam, ScanLog& scan_log,
-                          std::optional<RealtimeReport>& realtime) {
+                          const HealthLog& health, std::optional<RealtimeReport>& realtime) {
   Progress progress("taiga run", 0, "scans", stderr,
                     options.show_progress && isatty(fileno(stderr)));
   std::size_t scans = 0;
@@ -92,7 +96,7 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
     const auto* scan = std::get_if<io::Scan>(&event);
     if (scan) scan_log.chargeReadTime(scan->index, std::exchange(read_ms_since_scan, 0.0));
     slam.add(event);
-    if (scan) progress.update(++scans);
+    if (scan) progress.update(++scans, health.progressNote());
     return scan != nullptr;
   };
   for (const io::RecordingEvent& event : read_ahead) handle(event);
@@ -130,18 +134,22 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   TrajectoryRecorder trajectories;
   ScanLog scan_log(out);
   GnssRecorder gnss(config);
+  HealthLog health;
   slam.addObserver(trajectories);
   slam.addObserver(scan_log);
+  slam.addObserver(health);
   slam.addObserver(gnss);
 
   RunSummary summary;
   const auto wall_start = Clock::now();
   summary.scans =
-      feedRecording(recording, std::move(read_ahead), options, slam, scan_log, summary.realtime);
+      feedRecording(recording, std::move(read_ahead), options, slam, scan_log, health,
+                    summary.realtime);
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);
   scan_log.fillSummary(summary);
+  summary.health = health.report();
   if (trajectories.odometry().empty())
     throw InputError(fmt::format(
         "{}: no scan could be processed ({} scans, {} IMU samples): the odometry needs at least "

@@ -29,6 +29,32 @@ nlohmann::ordered_json gnssFusionJson(const mapping::GnssFusionReport& r) {
   return j;
 }
 
+/// The health monitor's verdict and its stretches; degraded ones only the first few (scans.csv
+/// has every scan).
+nlohmann::ordered_json healthJson(const HealthReport& h) {
+  constexpr std::size_t kListedDegraded = 20;
+  nlohmann::ordered_json lost = nlohmann::ordered_json::array();
+  nlohmann::ordered_json degraded = nlohmann::ordered_json::array();
+  std::size_t degraded_stretches = 0;
+  for (const HealthStretch& s : h.stretches) {
+    const bool is_lost = s.status == "lost";
+    degraded_stretches += !is_lost;
+    if (!is_lost && degraded.size() >= kListedDegraded) continue;
+    (is_lost ? lost : degraded)
+        .push_back({{"from_s", s.from_s}, {"to_s", s.to_s}, {"scans", s.scans},
+                    {"reason", s.reason}});
+  }
+  return {{"verdict", h.verdict()},
+          {"scans_ok", h.ok},
+          {"scans_degraded", h.degraded},
+          {"scans_lost", h.lost},
+          {"map_segments", h.map_segments},
+          {"ended_lost", h.ended_lost},
+          {"lost", lost},
+          {"degraded_stretches", degraded_stretches},
+          {"degraded", degraded}};
+}
+
 }  // namespace
 
 void writeSummary(const std::filesystem::path& path, const RunSummary& s,
@@ -55,6 +81,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"realtime_factor", s.realtime_factor},
       {"peak_memory_mb", s.peak_memory_mb},
       {"initialization", s.initialization},
+      {"health", healthJson(s.health)},
   };
   if (s.realtime) {
     j["realtime"] = {{"dropped_scans", s.realtime->dropped_scans},

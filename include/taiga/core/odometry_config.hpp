@@ -19,6 +19,39 @@ struct ImuNoiseConfig final : ConfigSection, ImuNoise {
   void validate() const override;
 };
 
+/// The `odometry.health` section: when a scan is `degraded` or the track `lost`
+/// (pipeline/health_monitor.hpp, docs/odometry.md "Health").
+struct HealthConfig final : ConfigSection {
+  /// The track is lost after this long without a scan judged ok (dead reckoning only), s.
+  double lost_after_s = 1.0;
+  /// ... and after at least this many scans in a row not ok (1 s is 2 scans at 2 Hz).
+  int lost_after_scans = 3;
+  /// Lost for this long more, the odometry gives up the old local map and starts a new one from
+  /// the next scan (a new map segment), s.
+  double reinitialize_after_s = 2.0;
+  /// Scans judged ok in a row that end a lost stretch.
+  int recovery_scans = 3;
+  /// Recent scans with a used lidar factor whose median fitness and inlier share are the
+  /// yardstick.
+  int history_scans = 10;
+  /// A fitness above this many times the recent median is degraded.
+  double fitness_ratio = 4.0;
+  /// Fitness below this is never judged against the median, m^2 (noise-level values).
+  double fitness_floor_m2 = 0.02;
+  /// An inlier share below this fraction of the recent median is degraded.
+  double inlier_share_ratio = 0.6;
+  /// Speeds above this are impossible for the rig: the track is lost, m/s.
+  double max_speed_mps = 30.0;
+  /// A change of velocity between consecutive states faster than this is degraded, m/s^2.
+  double max_acceleration_mps2 = 30.0;
+  /// Bias estimates beyond these are implausible for a working MEMS IMU: degraded.
+  double max_accel_bias_mps2 = 1.5;
+  double max_gyro_bias_dps = 10.0;
+
+  void visit(ConfigVisitor& v) override;
+  void validate() const override;
+};
+
 /// Sigmas of a registration-based pose measurement (thesis Eq. 36, see OdometryConfig::
 /// lidarSigmas()).
 struct LidarSigmas {
@@ -67,6 +100,7 @@ struct OdometryConfig final : ConfigSection {
   /// alignment, imu/gravity_alignment.hpp), s; 0 keeps the attitude from the IMU alone.
   double gravity_alignment_s = 2.0;
   ImuNoiseConfig imu;
+  HealthConfig health;
 
   /// Thesis Eq. 36 as docs/odometry.md reads it: sigma_sm while the fitness is at most tau_fs,
   /// times (fitness / tau_fs)^theta_smsc above it, times `inflation`; heading with its own sigma.

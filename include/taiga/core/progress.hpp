@@ -30,6 +30,8 @@ class Progress {
 
   /// Reports `done` items finished; redraws when 0.2 s have passed since the last redraw.
   void update(std::size_t done);
+  /// The same, with a note shown after the counts (e.g. "lost since 12.3 s"); empty: none.
+  void update(std::size_t done, std::string note);
   /// Draws the final state and ends the line. Called by the destructor if not before.
   void finish();
   bool enabled() const { return enabled_; }
@@ -45,6 +47,7 @@ class Progress {
   bool enabled_;
   bool finished_ = false;
   std::size_t done_ = 0;
+  std::string note_;
   Clock::time_point start_ = Clock::now();
   Clock::time_point last_draw_{};
 };

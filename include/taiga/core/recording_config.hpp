@@ -18,6 +18,9 @@ struct RecordingConfig final : ConfigSection {
   double scan_period_s = 0.1;
   /// Point field holding per-point time; empty recognizes t, time, offset_time, timestamp.
   std::string point_time_field;
+  /// The clouds were deskewed (motion-compensated) upstream into the lidar frame at the message
+  /// stamp: every point is taken at the stamp and nothing is deskewed again.
+  bool deskewed = false;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

@@ -73,13 +73,21 @@ struct PackedPoints {
 };
 
 /// How per-point times were obtained, for the user and for `taiga info`.
-enum class PointTimeSource { kRelativeField, kAbsoluteField, kColumnIndex, kAzimuth };
+enum class PointTimeSource { kRelativeField, kAbsoluteField, kColumnIndex, kAzimuth, kStamp };
+
+/// Whether the times were made up from the geometry (column or azimuth over a nominal sweep).
+inline bool timesInvented(PointTimeSource source) {
+  return source == PointTimeSource::kColumnIndex || source == PointTimeSource::kAzimuth;
+}
 
 struct PointDecodeOptions {
   /// Period of one sweep, s: used only when times must be derived from the geometry.
   double scan_period_s = 0.1;
   /// Field to read per-point time from; empty picks by the table above.
   std::string time_field;
+  /// Deskewed upstream (RecordingConfig::deskewed): every point at the stamp, any time field
+  /// ignored.
+  bool deskewed = false;
 };
 
 struct DecodedPoints {

@@ -28,6 +28,9 @@ struct Scan {
   double t_start_s = 0.0;    ///< time of the scan's first firing (column), s
   double t_end_s = 0.0;      ///< time of the scan's last point, s: the scan's event time
   PointCloud cloud_in_lidar; ///< valid returns only (no NaN, no zero-range points)
+  /// The per-point times were made up from the geometry (no time field: column or azimuth over
+  /// recording.scan_period_s), not measured.
+  bool times_invented = false;
 };
 
 using RecordingEvent = std::variant<Scan, ImuSample, GnssFix>;

@@ -32,6 +32,7 @@ struct ScanStats {
   std::size_t min_points = 0, median_points = 0, max_points = 0;
   double median_span_s = 0.0;          ///< median of (last point time - first point time)
   std::size_t scans_with_monotonic_times = 0;  ///< times non-decreasing along columns (or point order)
+  std::size_t scans_with_invented_times = 0;   ///< no time field: made up from the geometry
   bool has_columns = false;
   bool has_rings = false;
   bool has_intensities = false;

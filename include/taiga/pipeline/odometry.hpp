@@ -13,7 +13,8 @@
 //      covariance (thesis Eq. 36)
 //   6. fuse: the motion prior's state with the lidar factor (IMU: fixed-lag smoothing of the
 //      IMU and lidar factors -> pose, velocity, biases)
-//   7. keyframe test (thesis Eq. 37): the deskewed scan joins the local map
+//   7. health (health_monitor.hpp): ok, degraded or lost, against the run's own recent history
+//   8. keyframe test (thesis Eq. 37): an ok scan joins the local map
 //
 // With an IMU the odom frame is levelled once, gravity_alignment_s into the run (motion_prior.hpp):
 // the scan that levels it carries T_odom_unlevelled, and the earlier outcomes are in the
@@ -37,6 +38,7 @@
 
 namespace taiga::pipeline {
 
+class HealthMonitor;
 class MotionPrior;
 class ScanPreparation;
 struct FirstScan;
@@ -44,6 +46,17 @@ struct FirstScan;
 /// What happened to the lidar factor of a scan.
 enum class LidarFactor { kFirstScan, kUsed, kInflated, kRejected };
 const char* lidarFactorName(LidarFactor factor);
+
+/// The odometry's judgement of a scan (docs/odometry.md, "Health"): ok, degraded (a problem, but
+/// the track holds: the scan does not enter the map) or lost (no scan ok for longer than
+/// odometry.health.lost_after_s, an impossible state, or not yet recovered from either).
+enum class ScanStatus { kOk, kDegraded, kLost };
+const char* scanStatusName(ScanStatus status);
+
+struct ScanHealth {
+  ScanStatus status = ScanStatus::kOk;
+  std::string reason;  ///< why not ok; for an ok scan after a lost stretch, that it recovered
+};
 
 /// Milliseconds per stage of one scan (timing.csv).
 struct ScanTiming {
@@ -65,6 +78,10 @@ struct ScanOutcome {
   std::string lidar_note;  ///< why a factor was rejected or inflated
   registration::RegistrationResult registration;
   std::size_t source_points = 0;
+  ScanHealth health;
+  /// The local map segment the scan belongs to: 0, and one more each time the odometry gave up
+  /// a lost local map and started a new one.
+  std::uint64_t map_segment = 0;
   /// The keyframe this scan became (0, 1, ... in the order the odometry makes them; the
   /// keyframe store's ids), and its full deskewed scan in the body frame at t_s.
   std::optional<std::uint64_t> keyframe_id;
@@ -115,6 +132,7 @@ class Odometry {
   registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
                                                  const lie::SE3& guess_T_odom_body);
   void maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body);
+  void judgeHealth(ScanOutcome& outcome, bool registered);
 
   OdometryConfig config_;
   bool lidar_only_;
@@ -122,6 +140,8 @@ class Odometry {
   std::unique_ptr<ScanPreparation> preparation_;
   std::unique_ptr<MotionPrior> motion_;
   LocalMap local_map_;
+  std::unique_ptr<HealthMonitor> health_;
+  std::uint64_t map_segment_ = 0;
   std::optional<lie::SE3> last_keyframe_T_odom_body_;
   std::uint64_t keyframes_made_ = 0;
 };

@@ -28,6 +28,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "taiga/core/system_config.hpp"
 
@@ -66,6 +67,27 @@ struct GeorefRunReport {
   double map_export_s = 0.0;  ///< georef/map_epsgNNNN.las
 };
 
+/// Consecutive scans with the same status other than ok.
+struct HealthStretch {
+  std::string status;  ///< degraded or lost
+  double from_s = 0.0, to_s = 0.0;
+  std::size_t scans = 0;
+  std::string reason;  ///< the first scan's
+};
+
+/// What the odometry's health monitor said over the run (docs/odometry.md, "Health").
+struct HealthReport {
+  std::size_t ok = 0, degraded = 0, lost = 0;
+  /// Local map segments: 1, plus one each time a lost local map was given up.
+  std::size_t map_segments = 1;
+  std::vector<HealthStretch> stretches;  ///< in time order
+  bool ended_lost = false;
+  /// Lost and not re-attached to the same map: the run ended lost or started a new segment.
+  bool trackLost() const { return ended_lost || map_segments > 1; }
+  /// "ok", "degraded", "recovered" (lost, then re-attached to the same map) or "lost".
+  std::string verdict() const;
+};
+
 struct RunSummary {
   std::size_t scans = 0;            ///< scans read
   std::size_t scans_processed = 0;  ///< scans that gave a state
@@ -87,6 +109,7 @@ struct RunSummary {
   double realtime_factor = 0.0;  ///< recording duration / wall time (> 1: faster than the sensor)
   double peak_memory_mb = 0.0;
   std::string initialization;
+  HealthReport health;
   std::optional<RealtimeReport> realtime;  ///< with --realtime only
   std::optional<GeorefRunReport> georef;   ///< when the recording has GNSS fixes
 };

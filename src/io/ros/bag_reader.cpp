@@ -87,7 +87,7 @@ class BagDemux {
  public:
   BagDemux(const std::filesystem::path& path, const std::vector<std::string>& topics, const RecordingConfig& config)
       : path_(path), bag_(openBag(path)), view_(*bag_, rosbag::TopicQuery(topics)), it_(view_.begin()),
-        point_options_{config.scan_period_s, config.point_time_field} {}
+        point_options_{config.scan_period_s, config.point_time_field, config.deskewed} {}
 
   std::optional<RecordingEvent> next(const std::string& topic) {
     std::deque<RecordingEvent>& queue = queues_[topic];
@@ -138,11 +138,10 @@ class BagDemux {
                                 fmt::format("cloud layout: {} x {}{}", packed.height, packed.width,
                                             packed.height > 1 ? " (organized)" : ""),
                                 fmt::format("per-point times: {}", decoded.time_description)};
-      const bool guessed = decoded.time_source == PointTimeSource::kAzimuth ||
-                           decoded.time_source == PointTimeSource::kColumnIndex;
-      if (guessed) {
-        logger().warn("{}: {}: per-point times: {}; deskewing is only as good as this guess", path_.string(),
-                      m.getTopic(), decoded.time_description);
+      if (timesInvented(decoded.time_source)) {
+        logger().warn("{}: {}: per-point times: {}; deskewing is only as good as this guess (clouds deskewed "
+                      "upstream: recording.deskewed: true)",
+                      path_.string(), m.getTopic(), decoded.time_description);
       } else {
         logger().info("{}: {}: per-point times from {}", path_.string(), m.getTopic(), decoded.time_description);
       }
@@ -155,6 +154,7 @@ class BagDemux {
     scan.index = scan_count_++;
     std::tie(scan.t_start_s, scan.t_end_s) = decoded.cloud.timeSpan();
     scan.cloud_in_lidar = std::move(decoded.cloud);
+    scan.times_invented = timesInvented(decoded.time_source);
     return scan;
   }
 

@@ -1,0 +1,158 @@
+#include "health_monitor.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "taiga/core/angles.hpp"
+#include "taiga/core/percentile.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+/// Ok scans needed before the history is a yardstick.
+constexpr std::size_t kMinHistory = 5;
+
+void append(std::string& reasons, const std::string& reason) {
+  if (reason.empty()) return;
+  if (!reasons.empty()) reasons += "; ";
+  reasons += reason;
+}
+
+template <class Field>
+double medianOf(const std::deque<Field>& history, double Field::*member) {
+  std::vector<double> values;
+  values.reserve(history.size());
+  for (const Field& h : history) values.push_back(h.*member);
+  return percentile(values, 50.0);
+}
+
+}  // namespace
+
+const char* scanStatusName(ScanStatus status) {
+  switch (status) {
+    case ScanStatus::kOk:
+      return "ok";
+    case ScanStatus::kDegraded:
+      return "degraded";
+    case ScanStatus::kLost:
+      return "lost";
+  }
+  return "?";
+}
+
+std::string HealthMonitor::relativeProblems(const HealthEvidence& scan) const {
+  if (!scan.registered || scan.lidar != LidarFactor::kUsed || history_.size() < kMinHistory)
+    return {};
+  std::string reasons;
+  const double median_fitness_m2 = medianOf(history_, &Recent::fitness_m2);
+  if (scan.fitness_m2 > config_.fitness_floor_m2 &&
+      scan.fitness_m2 > config_.fitness_ratio * median_fitness_m2)
+    append(reasons, fmt::format("fitness {:.3f} m^2 is {:.1f}x the recent median {:.3f}",
+                                scan.fitness_m2, scan.fitness_m2 / median_fitness_m2,
+                                median_fitness_m2));
+  const double median_share = medianOf(history_, &Recent::inlier_share);
+  if (scan.inlier_share < config_.inlier_share_ratio * median_share)
+    append(reasons, fmt::format("{:.0f} % of the points matched the map, recently {:.0f} %",
+                                100.0 * scan.inlier_share, 100.0 * median_share));
+  return reasons;
+}
+
+std::string HealthMonitor::seriousProblems(const HealthEvidence& scan, bool& impossible) const {
+  std::string reasons;
+  const double speed_mps = scan.v_odom.norm();
+  impossible = !scan.v_odom.allFinite() || speed_mps > config_.max_speed_mps;
+  if (impossible)
+    append(reasons, fmt::format("speed {:.1f} m/s is beyond the rig's {:.0f}", speed_mps,
+                                config_.max_speed_mps));
+  if (previous_t_s_ && scan.t_s > *previous_t_s_) {
+    const double acceleration_mps2 =
+        (scan.v_odom - previous_v_odom_).norm() / (scan.t_s - *previous_t_s_);
+    if (acceleration_mps2 > config_.max_acceleration_mps2)
+      append(reasons, fmt::format("velocity jumped at {:.0f} m/s^2", acceleration_mps2));
+  }
+  if (scan.estimates_bias) {
+    const double accel_bias_mps2 = scan.bias.accel_mps2.norm();
+    const double gyro_bias_dps = scan.bias.gyro_radps.norm() * kDegPerRad;
+    if (accel_bias_mps2 > config_.max_accel_bias_mps2)
+      append(reasons, fmt::format("accelerometer bias estimate {:.2f} m/s^2 is implausible",
+                                  accel_bias_mps2));
+    if (gyro_bias_dps > config_.max_gyro_bias_dps)
+      append(reasons,
+             fmt::format("gyroscope bias estimate {:.1f} deg/s is implausible", gyro_bias_dps));
+  }
+  if (scan.registered && scan.lidar == LidarFactor::kRejected)
+    append(reasons, "lidar factor rejected: " + scan.lidar_note);
+  if (scan.registered && scan.lidar == LidarFactor::kInflated) append(reasons, scan.lidar_note);
+  return reasons;
+}
+
+void HealthMonitor::remember(const HealthEvidence& scan) {
+  // Every used registration, also one the relative checks found odd: a lasting change of scene
+  // (a clearing, a young or stale local map) becomes the new yardstick within half the history,
+  // instead of degrading every scan from then on and, since degraded scans make no keyframes,
+  // starving the map for good. Never while lost: the yardstick must not learn a broken state.
+  if (!scan.registered || scan.lidar != LidarFactor::kUsed || lost_since_t_s_) return;
+  history_.push_back({scan.fitness_m2, scan.inlier_share});
+  while (history_.size() > static_cast<std::size_t>(config_.history_scans)) history_.pop_front();
+}
+
+ScanHealth HealthMonitor::judge(const HealthEvidence& scan) {
+  if (!last_sound_t_s_) last_sound_t_s_ = scan.t_s;  // the first scan starts the clock
+  bool impossible = false;
+  const std::string serious = seriousProblems(scan, impossible);
+  const std::string relative = relativeProblems(scan);
+  ScanHealth health;
+  append(health.reason, serious);
+  append(health.reason, relative);
+  previous_t_s_ = scan.t_s;
+  previous_v_odom_ = scan.v_odom;
+  restart_local_map_ = false;
+  remember(scan);
+
+  // Only serious problems lose the track: the relative ones may be a new kind of scene. Lost
+  // takes both time and scans (1 s is 10 scans at 10 Hz but 2 at 2 Hz).
+  const bool sound = serious.empty();
+  const bool good = sound && relative.empty();
+  serious_in_a_row_ = sound ? 0 : serious_in_a_row_ + 1;
+  if (sound) last_sound_t_s_ = scan.t_s;
+  const double unsound_s = scan.t_s - *last_sound_t_s_;
+  const bool long_unsound =
+      unsound_s > config_.lost_after_s && serious_in_a_row_ >= config_.lost_after_scans;
+  // Recovery takes scans that pass every check, against the yardstick from before the loss.
+  ok_in_a_row_ = good ? ok_in_a_row_ + 1 : 0;
+  if (good && lost_since_t_s_ && ok_in_a_row_ < config_.recovery_scans) {
+    health.status = ScanStatus::kLost;
+    health.reason =
+        fmt::format("recovering: {} of {} scans ok", ok_in_a_row_, config_.recovery_scans);
+  } else if (good) {
+    if (lost_since_t_s_)
+      health.reason = fmt::format("recovered, lost since {:.3f} s", *lost_since_t_s_);
+    lost_since_t_s_.reset();
+    health.status = ScanStatus::kOk;
+  } else if (impossible || lost_since_t_s_ || long_unsound) {
+    if (!lost_since_t_s_) lost_since_t_s_ = scan.t_s;
+    health.status = ScanStatus::kLost;
+    const double lost_for_s = scan.t_s - *lost_since_t_s_;
+    if (!impossible)
+      health.reason = fmt::format("no sound scan for {:.1f} s: {}", unsound_s, health.reason);
+    restart_local_map_ = unsound_s > config_.lost_after_s + config_.reinitialize_after_s ||
+                         lost_for_s > config_.reinitialize_after_s + config_.lost_after_s;
+  } else {
+    health.status = ScanStatus::kDegraded;
+  }
+  return health;
+}
+
+void HealthMonitor::forgetHistory() { history_.clear(); }
+
+void HealthMonitor::localMapRestarted() {
+  history_.clear();
+  restart_local_map_ = false;
+  // The clock restarts too: the new map's first scans are judged on their own.
+  last_sound_t_s_.reset();
+  serious_in_a_row_ = 0;
+}
+
+}  // namespace taiga::pipeline

@@ -1,0 +1,75 @@
+#pragma once
+// The odometry's health monitor (docs/odometry.md, "Health"): every scan gets a status, ok,
+// degraded or lost, with the reason, judged against the run's own recent history rather than
+// against absolute limits alone, so that a forest, a field and a corridor each set their own
+// yardstick. Only ok scans become keyframes (odometry.cpp), so a scan the monitor distrusts never
+// enters the local map. Internal to the pipeline.
+
+#include <deque>
+#include <optional>
+#include <string>
+
+#include "taiga/core/odometry_config.hpp"
+#include "taiga/pipeline/odometry.hpp"
+
+namespace taiga::pipeline {
+
+/// What the monitor is shown of one scan.
+struct HealthEvidence {
+  double t_s = 0.0;
+  /// False for the scans before the local map has its first keyframe: nothing to judge.
+  bool registered = false;
+  LidarFactor lidar = LidarFactor::kFirstScan;
+  std::string lidar_note;
+  double fitness_m2 = 0.0;
+  /// Inliers of the registration over the scan's source points, 0..1.
+  double inlier_share = 0.0;
+  /// The state after fusion and whether its biases are estimated (an IMU).
+  Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();
+  imu::ImuBias bias;
+  bool estimates_bias = false;
+};
+
+class HealthMonitor {
+ public:
+  /// `good_fitness_m2`: the fitness up to which a registration is as good as it gets (the
+  /// lidar factor's tau_fs); worse ones are judged but never become the yardstick.
+  HealthMonitor(const HealthConfig& config, double good_fitness_m2)
+      : config_(config), good_fitness_m2_(good_fitness_m2) {}
+
+  ScanHealth judge(const HealthEvidence& scan);
+  /// True when the scan just judged asks for a fresh local map: lost for longer than
+  /// reinitialize_after_s, with no sign that the old one still fits.
+  bool restartLocalMap() const { return restart_local_map_; }
+  /// The local map was restarted after a loss: the next scans rebuild the history and start the
+  /// clock anew.
+  void localMapRestarted();
+  /// The local map starts over for another reason (the odom frame levelled): its first scans
+  /// match less of it than the old map's did, so the history starts over.
+  void forgetHistory();
+
+ private:
+  /// Problems that, lasting, lose the track: a rejected or inflated lidar factor, a velocity
+  /// jump, implausible biases; `impossible` for a state no rig can have (lost at once).
+  std::string seriousProblems(const HealthEvidence& scan, bool& impossible) const;
+  /// Fitness and inlier share far from the recent history: degraded, never lost by themselves.
+  std::string relativeProblems(const HealthEvidence& scan) const;
+  void remember(const HealthEvidence& scan);
+
+  HealthConfig config_;
+  double good_fitness_m2_;
+  struct Recent {
+    double fitness_m2 = 0.0;
+    double inlier_share = 0.0;
+  };
+  std::deque<Recent> history_;  ///< the latest used registrations, oldest first
+  std::optional<double> last_sound_t_s_;  ///< the latest scan without a serious problem
+  std::optional<double> previous_t_s_;
+  Eigen::Vector3d previous_v_odom_ = Eigen::Vector3d::Zero();
+  std::optional<double> lost_since_t_s_;
+  int ok_in_a_row_ = 0;
+  int serious_in_a_row_ = 0;
+  bool restart_local_map_ = false;
+};
+
+}  // namespace taiga::pipeline

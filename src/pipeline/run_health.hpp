@@ -1,0 +1,27 @@
+#pragma once
+// The health monitor's verdicts as `taiga run` reports them (docs/odometry.md, "Health"): a
+// warning on the terminal when the track is lost and when it recovers, the stretches of
+// degraded and lost scans, and the status for the progress line. Internal to the pipeline.
+
+#include <optional>
+#include <string>
+
+#include "taiga/pipeline/run.hpp"
+#include "taiga/pipeline/slam_system.hpp"
+
+namespace taiga::pipeline {
+
+class HealthLog final : public SlamObserver {
+ public:
+  void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
+
+  /// For the progress line: empty while ok, else e.g. "lost since 12.3 s".
+  std::string progressNote() const;
+  const HealthReport& report() const { return report_; }
+
+ private:
+  HealthReport report_;
+  std::optional<ScanStatus> previous_;
+};
+
+}  // namespace taiga::pipeline
