@@ -18,7 +18,7 @@ taiga=${TAIGA:-$here/../build/bin/taiga}
 work=${1:-/tmp/robustness}
 mkdir -p "$work"
 csv=$work/robustness.csv
-[[ -f $csv ]] || echo "scenario,realism,seed,duration_s,exit_code,scans,lidar_factors_rejected,loop_closures,ate_m,ate_odometry_m,ate_max_m,drift_m,drift_percent,path_m,realtime_factor" > "$csv"
+[[ -f $csv ]] || echo "scenario,realism,seed,duration_s,exit_code,scans,lidar_factors_rejected,loop_closures,ate_m,ate_odometry_m,ate_max_m,drift_m,drift_percent,path_m,realtime_factor,health,scans_degraded,scans_lost" > "$csv"
 
 evaluate() {  # est ref -> "rmse max drift drift% path" (or "nan ..." when it cannot be scored)
   "$taiga" eval --json --est "$1" --ref "$2" 2>/dev/null | python3 -c '
@@ -52,11 +52,13 @@ for scenario in ${SCENARIOS:-handheld-loop harvester dense_spruce}; do
 import json, sys
 try:
     s = json.load(open(sys.argv[1]))
-    print(s["scans"], s["lidar_factors_rejected"], s["loop_closures"], s["realtime_factor"], s["duration_s"])
+    h = s.get("health", {})
+    print(s["scans"], s["lidar_factors_rejected"], s["loop_closures"], s["realtime_factor"], s["duration_s"],
+          h.get("verdict", "nan"), h.get("scans_degraded", "nan"), h.get("scans_lost", "nan"))
 except Exception:
-    print("nan nan nan nan nan")' "$run/summary.json")
-      read -r scans rejected loops rtf dur <<< "$summary"
-      echo "$scenario,$realism,$seed,$dur,$code,$scans,$rejected,$loops,$ate,$ate_odom,$ate_max,$drift,$drift_pct,$path,$rtf" >> "$csv"
+    print("nan nan nan nan nan nan nan nan")' "$run/summary.json")
+      read -r scans rejected loops rtf dur health degraded lost <<< "$summary"
+      echo "$scenario,$realism,$seed,$dur,$code,$scans,$rejected,$loops,$ate,$ate_odom,$ate_max,$drift,$drift_pct,$path,$rtf,$health,$degraded,$lost" >> "$csv"
       tail -1 "$csv"
       [[ ${KEEP:-0} == 1 ]] || rm -rf "$sim/recording.bag" "$run/keyframes" "$run/map.las"
     done

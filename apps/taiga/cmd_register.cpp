@@ -14,6 +14,7 @@
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/registration/registration.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
+#include "taiga/registration/yaw_search.hpp"
 
 namespace taiga::app {
 namespace {
@@ -22,6 +23,7 @@ struct RegisterOptions {
   std::string method = "ndt";
   double resolution_m = 1.0;
   double voxel_m = 0.25;
+  int yaw_hypotheses = 0;  ///< 0: 12 without --guess, 1 with
   bool json = false;
 };
 
@@ -60,8 +62,9 @@ std::string finiteOrNull(double value) {
   return std::isfinite(value) ? fmt::format("{:.6g}", value) : "null";
 }
 
-std::string formatResult(const RegisterOptions& o, const registration::RegistrationResult& r,
+std::string formatResult(const RegisterOptions& o, const registration::YawSearchResult& search,
                          double time_ms, std::size_t n_source, std::size_t n_target) {
+  const registration::RegistrationResult& r = search.best;
   const Eigen::Matrix4d T = r.T_target_source.matrix();
   // R = Rz(yaw) Ry(pitch) Rx(roll), as lie::SO3::fromRollPitchYaw.
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
@@ -88,10 +91,12 @@ std::string formatResult(const RegisterOptions& o, const registration::Registrat
     out = fmt::format(
         "{{\"method\": \"{}\", \"T_target_source\": [{}], \"converged\": {}, \"reason\": \"{}\", "
         "\"iterations\": {}, \"num_inliers\": {}, \"fitness_m2\": {}, \"hessian_condition\": {}, "
-        "\"translation_condition\": {}, \"time_ms\": {:.3f}, \"source_points\": {}, "
+        "\"translation_condition\": {}, \"overlap\": {:.4f}, \"ambiguous\": {}, "
+        "\"yaw_hypotheses\": {}, \"time_ms\": {:.3f}, \"source_points\": {}, "
         "\"target_points\": {}}}\n",
         o.method, rows, r.converged, reason, r.iterations, r.num_inliers, fitness, condition,
-        finiteOrNull(r.translation_condition), time_ms, n_source, n_target);
+        finiteOrNull(r.translation_condition), search.overlap, search.ambiguous, search.hypotheses,
+        time_ms, n_source, n_target);
   } else {
     out += fmt::format("method: {}\nT_target_source:\n", o.method);
     for (int i = 0; i < 4; ++i) {
@@ -105,6 +110,15 @@ std::string formatResult(const RegisterOptions& o, const registration::Registrat
                        r.reason.empty() ? "" : " (" + r.reason + ")");
     out += fmt::format("iterations: {}\ninliers: {}\nfitness_m2: {:.6f}\n", r.iterations,
                        r.num_inliers, r.fitness_m2);
+    out += fmt::format("overlap: {:.1f} % of the source within {} m of the target\n",
+                       100.0 * search.overlap, registration::YawSearchOptions{}.inlier_distance_m);
+    out += fmt::format("yaw_hypotheses: {}{}\n", search.hypotheses,
+                       search.rival_overlap > 0.0
+                           ? fmt::format(" (best distinct rival: {:.1f} % overlap, {:.2f} m / "
+                                         "{:.1f} deg away)",
+                                         100.0 * search.rival_overlap, search.rival_m,
+                                         search.rival_deg)
+                           : std::string());
     out +=
         fmt::format("hessian_condition: {:.4g}\ntime_ms: {:.1f}\n", r.hessian_condition, time_ms);
   }
@@ -127,17 +141,14 @@ int runRegister(const RegisterOptions& o) {
       target = registration::voxelDownsample(target, o.voxel_m);
     }
   }
-  config.compute_fitness = false;
-  registration::RegistrationResult result =
-      registration::registerClouds(source, target, guess, config);
+  // Without a guess the identity may be far off: several headings, and ambiguity reported.
+  const int hypotheses = o.yaw_hypotheses > 0 ? o.yaw_hypotheses : (o.guess.empty() ? 12 : 1);
+  const registration::YawSearchResult search = registration::registerWithYawSearch(
+      source, target, guess, config, {.hypotheses = hypotheses});
   const double time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (!source.empty() && !target.empty()) {
-    result.fitness_m2 =
-        registration::fitnessScore(source, registration::KdTree(target), result.T_target_source);
-  }
-  fmt::print("{}", formatResult(o, result, time_ms, source.size(), target.size()));
-  return result.converged ? kExitOk : kExitFailure;
+  fmt::print("{}", formatResult(o, search, time_ms, source.size(), target.size()));
+  return search.best.converged ? kExitOk : kExitFailure;
 }
 }  // namespace
 
@@ -162,6 +173,12 @@ Command addRegisterCommand(CLI::App& tool) {
           "Voxel-grid leaf for the source (and for GICP the target), m; 0 keeps all points")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  parser
+      ->add_option("--yaw-hypotheses", options->yaw_hypotheses,
+                   "Start from this many headings about the guess (360/N deg apart) and keep the "
+                   "best overlap; a distinct solution nearly as good is reported as ambiguous "
+                   "(not converged). Default: 12 without --guess, 1 with")
+      ->check(CLI::Range(1, 360));
   parser->add_flag("--json", options->json, "Print JSON instead of text");
   return {parser, [options] { return runRegister(*options); }, options};
 }

@@ -50,7 +50,7 @@ bool KdTree::nearest(const Eigen::Vector3d& query, std::size_t& index,
   return knn(query, 1, &index, &squared_distance_m2) == 1;
 }
 
-double fitnessScore(std::span<const Eigen::Vector3d> source, const KdTree& target,
+Agreement agreement(std::span<const Eigen::Vector3d> source, const KdTree& target,
                     const lie::SE3& T_target_source, double max_distance_m) {
   struct Partial {
     double sum = 0.0;
@@ -73,8 +73,17 @@ double fitnessScore(std::span<const Eigen::Vector3d> source, const KdTree& targe
         a.sum += b.sum;
         a.count += b.count;
       });
-  if (total.count == 0) return std::numeric_limits<double>::quiet_NaN();
-  return total.sum / static_cast<double>(total.count);
+  Agreement a;
+  a.fitness_m2 = total.count == 0 ? std::numeric_limits<double>::quiet_NaN()
+                                  : total.sum / static_cast<double>(total.count);
+  a.share = source.empty() ? 0.0
+                           : static_cast<double>(total.count) / static_cast<double>(source.size());
+  return a;
+}
+
+double fitnessScore(std::span<const Eigen::Vector3d> source, const KdTree& target,
+                    const lie::SE3& T_target_source, double max_distance_m) {
+  return agreement(source, target, T_target_source, max_distance_m).fitness_m2;
 }
 
 }  // namespace taiga::registration

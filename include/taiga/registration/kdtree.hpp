@@ -33,6 +33,15 @@ class KdTree {
   std::unique_ptr<Impl> impl_;
 };
 
+/// How well T_target_source * source lies on the target: the thesis fitness score (below) and
+/// the share of the source points within max_distance_m of a target point (the overlap).
+struct Agreement {
+  double fitness_m2 = 0.0;  ///< NaN when no point is within max_distance_m
+  double share = 0.0;       ///< 0..1
+};
+Agreement agreement(std::span<const Eigen::Vector3d> source, const KdTree& target,
+                    const lie::SE3& T_target_source, double max_distance_m);
+
 /// Thesis fitness score: mean over the source points of the squared distance (m^2) from
 /// T_target_source * p to the closest target point, counting only distances below
 /// max_distance_m. NaN when no point counts. Parallel, deterministic.
