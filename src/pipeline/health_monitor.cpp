@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "taiga/core/angles.hpp"
@@ -132,23 +133,33 @@ ScanHealth HealthMonitor::judge(const HealthEvidence& scan) {
     lost_since_t_s_.reset();
     health.status = ScanStatus::kOk;
   } else if (impossible || lost_since_t_s_ || long_unsound) {
-    if (!lost_since_t_s_) lost_since_t_s_ = scan.t_s;
+    if (!lost_since_t_s_) lost_since_t_s_ = lost_on_this_map_since_t_s_ = scan.t_s;
     health.status = ScanStatus::kLost;
-    const double lost_for_s = scan.t_s - *lost_since_t_s_;
     if (!impossible)
       health.reason = fmt::format("no sound scan for {:.1f} s: {}", unsound_s, health.reason);
-    restart_local_map_ = unsound_s > config_.lost_after_s + config_.reinitialize_after_s ||
-                         lost_for_s > config_.reinitialize_after_s + config_.lost_after_s;
+    restart_local_map_ = scan.t_s - *lost_on_this_map_since_t_s_ > config_.reinitialize_after_s;
   } else {
     health.status = ScanStatus::kDegraded;
   }
   return health;
 }
 
+bool HealthMonitor::hasYardstick() const { return history_.size() >= kMinHistory; }
+
+bool HealthMonitor::registrationSuspect(double fitness_m2, double inlier_share) const {
+  if (!std::isfinite(fitness_m2) || fitness_m2 > max_fitness_m2_) return true;
+  return !relativeProblems({.registered = true,
+                            .lidar = LidarFactor::kUsed,
+                            .fitness_m2 = fitness_m2,
+                            .inlier_share = inlier_share})
+              .empty();
+}
+
 void HealthMonitor::forgetHistory() { history_.clear(); }
 
-void HealthMonitor::localMapRestarted() {
+void HealthMonitor::localMapRestarted(double t_s) {
   history_.clear();
+  lost_on_this_map_since_t_s_ = t_s;
   restart_local_map_ = false;
   // The clock restarts too: the new map's first scans are judged on their own.
   last_sound_t_s_.reset();

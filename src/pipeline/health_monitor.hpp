@@ -32,18 +32,23 @@ struct HealthEvidence {
 
 class HealthMonitor {
  public:
-  /// `good_fitness_m2`: the fitness up to which a registration is as good as it gets (the
-  /// lidar factor's tau_fs); worse ones are judged but never become the yardstick.
-  HealthMonitor(const HealthConfig& config, double good_fitness_m2)
-      : config_(config), good_fitness_m2_(good_fitness_m2) {}
+  /// `max_fitness_m2`: the odometry's limit above which a registration is rejected.
+  HealthMonitor(const HealthConfig& config, double max_fitness_m2)
+      : config_(config), max_fitness_m2_(max_fitness_m2) {}
 
   ScanHealth judge(const HealthEvidence& scan);
+  /// Whether a registration would be judged a problem, before it is fused: a fitness that is
+  /// not finite or above max_fitness_m2, or far from the recent history.
+  bool registrationSuspect(double fitness_m2, double inlier_share) const;
+  /// Whether the recent history is long enough to judge against (not right after the local map
+  /// started over).
+  bool hasYardstick() const;
   /// True when the scan just judged asks for a fresh local map: lost for longer than
   /// reinitialize_after_s, with no sign that the old one still fits.
   bool restartLocalMap() const { return restart_local_map_; }
   /// The local map was restarted after a loss: the next scans rebuild the history and start the
   /// clock anew.
-  void localMapRestarted();
+  void localMapRestarted(double t_s);
   /// The local map starts over for another reason (the odom frame levelled): its first scans
   /// match less of it than the old map's did, so the history starts over.
   void forgetHistory();
@@ -57,7 +62,7 @@ class HealthMonitor {
   void remember(const HealthEvidence& scan);
 
   HealthConfig config_;
-  double good_fitness_m2_;
+  double max_fitness_m2_;
   struct Recent {
     double fitness_m2 = 0.0;
     double inlier_share = 0.0;
@@ -67,6 +72,8 @@ class HealthMonitor {
   std::optional<double> previous_t_s_;
   Eigen::Vector3d previous_v_odom_ = Eigen::Vector3d::Zero();
   std::optional<double> lost_since_t_s_;
+  /// Since when the track is lost on the current local map (the loss, or the last restart).
+  std::optional<double> lost_on_this_map_since_t_s_;
   int ok_in_a_row_ = 0;
   int serious_in_a_row_ = 0;
   bool restart_local_map_ = false;

@@ -6,6 +6,7 @@
 #include "lidar_factor.hpp"
 #include "motion_prior.hpp"
 #include "scan_preparation.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/preprocess/voxel_filter.hpp"
 #include "taiga/registration/kdtree.hpp"
@@ -14,6 +15,16 @@ namespace taiga::pipeline {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// A wide-basin candidate replaces the registration only when it overlaps the map this much
+/// better: a near tie is the same basin seen through noise.
+constexpr double kClearlyBetter = 1.1;
+
+double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
+  return source_points > 0
+             ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
+             : 0.0;
+}
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -53,7 +64,7 @@ Odometry::Odometry(const OdometryConfig& config, const RigConfig& rig, bool lida
                  config.local_map_keyframes,
                  registration_.method == registration::Method::kGicp ? LocalMap::Target::kGicp
                                                                      : LocalMap::Target::kNdt),
-      health_(std::make_unique<HealthMonitor>(config.health, config.fitness_threshold_m2)) {}
+      health_(std::make_unique<HealthMonitor>(config.health, config.max_fitness_m2)) {}
 
 Odometry::~Odometry() = default;
 
@@ -117,7 +128,13 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   // 4. Register to the local map (none before the first keyframe without an IMU).
   stage = Clock::now();
   const bool has_map = !local_map_.empty();
-  if (has_map) outcome.registration = registerToMap(source_cloud.positions, prediction.T_odom_body);
+  if (has_map) {
+    outcome.registration = registerToMap(source_cloud.positions, prediction.T_odom_body);
+    const lie::Vector6 innovation =
+        (prediction.T_odom_body.inverse() * outcome.registration.T_target_source).Log();
+    outcome.innovation_m = innovation.head<3>().norm();
+    outcome.innovation_deg = innovation.tail<3>().norm() * kDegPerRad;
+  }
   outcome.timing.registration_ms = msSince(stage);
 
   // 5. Judge it; 6. fuse it with the motion prior.
@@ -155,6 +172,46 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
 registration::RegistrationResult Odometry::registerToMap(const std::vector<Eigen::Vector3d>& source,
                                                          const lie::SE3& guess_T_odom_body) {
   local_map_.beginRegistration();
+  registration::RegistrationResult result = alignToMap(source, guess_T_odom_body);
+  // Only against an established map: the overlap with a map of one or two scans tells nothing.
+  if (!lidar_only_ || !health_->hasYardstick() ||
+      !health_->registrationSuspect(result.fitness_m2, inlierShare(result, source.size())))
+    return result;
+  // A constant velocity is a poor prediction through a fast turn between sparse scans: the
+  // registration may have settled in a wrong basin. Start again from headings about the
+  // vertical around the prediction; keep the best overlap among the candidates that the health
+  // monitor would not find suspect themselves (a partial scan, e.g. most packets lost, makes no
+  // candidate look normal, and the first result stays) (docs/odometry.md, "Wide basin").
+  const double inlier_distance_m = config_.ndt_resolution_m;
+  const auto overlap = [&](const registration::RegistrationResult& r) {
+    return registration::agreement(source, local_map_.kdTree(), r.T_target_source,
+                                   inlier_distance_m)
+        .share;
+  };
+  double best_overlap = overlap(result);
+  const double first_overlap = best_overlap;
+  int tries = 0;
+  for (const double yaw_deg : {-20.0, 20.0, -40.0, 40.0, -60.0, 60.0}) {
+    const lie::SO3 turn = lie::SO3::fromRollPitchYaw(0.0, 0.0, yaw_deg * kRadPerDeg);
+    const lie::SE3 guess(turn * guess_T_odom_body.rotation(), guess_T_odom_body.translation());
+    registration::RegistrationResult candidate = alignToMap(source, guess);
+    ++tries;
+    if (health_->registrationSuspect(candidate.fitness_m2,
+                                     inlierShare(candidate, source.size())))
+      continue;
+    const double candidate_overlap = overlap(candidate);
+    if (candidate_overlap > kClearlyBetter * best_overlap) {
+      best_overlap = candidate_overlap;
+      result = std::move(candidate);
+    }
+  }
+  logger().debug("wide-basin search: {} headings, overlap {:.2f} -> {:.2f}", tries, first_overlap,
+                 best_overlap);
+  return result;
+}
+
+registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::Vector3d>& source,
+                                                      const lie::SE3& guess_T_odom_body) const {
   registration::RegistrationResult result;
   if (registration_.method == registration::Method::kGicp) {
     result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),
@@ -187,9 +244,7 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
        .lidar = outcome.lidar,
        .lidar_note = outcome.lidar_note,
        .fitness_m2 = r.fitness_m2,
-       .inlier_share = outcome.source_points > 0 ? static_cast<double>(r.num_inliers) /
-                                                       static_cast<double>(outcome.source_points)
-                                                 : 0.0,
+       .inlier_share = inlierShare(r, outcome.source_points),
        .v_odom = outcome.v_odom,
        .bias = outcome.bias,
        .estimates_bias = !lidar_only_});
@@ -198,7 +253,7 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
     // this scan, placed by dead reckoning (docs/odometry.md, "Health").
     local_map_.clear();
     last_keyframe_T_odom_body_.reset();
-    health_->localMapRestarted();
+    health_->localMapRestarted(outcome.t_s);
     ++map_segment_;
     logger().warn("scan {} at {:.3f} s: lost for long, the local map starts over (segment {})",
                   outcome.scan_index, outcome.t_s, map_segment_);

@@ -16,7 +16,7 @@ namespace {
 using ::testing::HasSubstr;
 
 constexpr double kPeriod_s = 0.1;
-constexpr double kGoodFitness_m2 = 0.3;  // OdometryConfig::fitness_threshold_m2
+constexpr double kMaxFitness_m2 = 2.0;  // OdometryConfig::max_fitness_m2
 
 HealthEvidence goodScan(double t_s) {
   return {.t_s = t_s,
@@ -42,12 +42,12 @@ double warmUp(HealthMonitor& monitor, int n) {
 }
 
 TEST(HealthMonitor, GoodScansAreOk) {
-  HealthMonitor monitor(HealthConfig{}, kGoodFitness_m2);
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   warmUp(monitor, 50);
 }
 
 TEST(HealthMonitor, FitnessFarAboveTheRunsOwnMedianIsDegraded) {
-  HealthMonitor monitor(HealthConfig{}, kGoodFitness_m2);
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   const double t_s = warmUp(monitor, 10);
   HealthEvidence scan = goodScan(t_s);
   scan.fitness_m2 = 0.3;  // 6x the median 0.05, below every absolute limit
@@ -61,7 +61,7 @@ TEST(HealthMonitor, FitnessFarAboveTheRunsOwnMedianIsDegraded) {
 }
 
 TEST(HealthMonitor, ALastingChangeOfSceneBecomesTheNewYardstickAndNeverLosesTheTrack) {
-  HealthMonitor monitor(HealthConfig{}, kGoodFitness_m2);
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   double t_s = warmUp(monitor, 10);
   // From now on every scan fits four times worse and matches half as much (a young local map,
   // a clearing): degraded at first, never lost, ok again once half the history has seen it.
@@ -79,7 +79,7 @@ TEST(HealthMonitor, ALastingChangeOfSceneBecomesTheNewYardstickAndNeverLosesTheT
 }
 
 TEST(HealthMonitor, AFewMatchedPointsAreDegraded) {
-  HealthMonitor monitor(HealthConfig{}, kGoodFitness_m2);
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   HealthEvidence scan = goodScan(warmUp(monitor, 10));
   scan.inlier_share = 0.3;  // recently 90 %
   const ScanHealth health = monitor.judge(scan);
@@ -88,7 +88,7 @@ TEST(HealthMonitor, AFewMatchedPointsAreDegraded) {
 }
 
 TEST(HealthMonitor, NoHistoryNoRelativeJudgement) {
-  HealthMonitor monitor(HealthConfig{}, kGoodFitness_m2);
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   HealthEvidence scan = goodScan(0.0);
   scan.fitness_m2 = 1.0;
   EXPECT_EQ(monitor.judge(scan).status, ScanStatus::kOk);
@@ -99,7 +99,7 @@ TEST(HealthMonitor, RejectedFactorsDegradeThenLoseTheTrackThenRecover) {
   config.lost_after_s = 0.5;
   config.recovery_scans = 3;
   config.reinitialize_after_s = 100.0;
-  HealthMonitor monitor(config, kGoodFitness_m2);
+  HealthMonitor monitor(config, kMaxFitness_m2);
   double t_s = warmUp(monitor, 10);
   const double last_ok_s = 9 * kPeriod_s;  // as warmUp stamped it
   std::vector<ScanStatus> statuses;
@@ -133,7 +133,7 @@ TEST(HealthMonitor, ABadScanBetweenRecoveringOnesRestartsTheCount) {
   HealthConfig config;
   config.lost_after_s = 0.2;
   config.recovery_scans = 2;
-  HealthMonitor monitor(config, kGoodFitness_m2);
+  HealthMonitor monitor(config, kMaxFitness_m2);
   double t_s = warmUp(monitor, 10);
   for (int k = 0; k < 5; ++k, t_s += kPeriod_s) monitor.judge(rejectedScan(t_s));
   EXPECT_EQ(monitor.judge(goodScan(t_s)).status, ScanStatus::kLost);
@@ -146,7 +146,7 @@ TEST(HealthMonitor, ABadScanBetweenRecoveringOnesRestartsTheCount) {
 }
 
 TEST(HealthMonitor, ImpossibleSpeedIsLostAtOnce) {
-  HealthMonitor monitor(HealthConfig{}, kGoodFitness_m2);
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   HealthEvidence scan = goodScan(warmUp(monitor, 10));
   scan.v_odom = Eigen::Vector3d(0.0, 45.0, 0.0);
   const ScanHealth health = monitor.judge(scan);
@@ -155,7 +155,7 @@ TEST(HealthMonitor, ImpossibleSpeedIsLostAtOnce) {
 }
 
 TEST(HealthMonitor, VelocityJumpAndImplausibleBiasesAreDegraded) {
-  HealthMonitor monitor(HealthConfig{}, kGoodFitness_m2);
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   double t_s = warmUp(monitor, 10);
   HealthEvidence jump = goodScan(t_s);
   jump.v_odom = Eigen::Vector3d(1.0, 5.0, 0.0);  // 5 m/s in 0.1 s: 50 m/s^2
@@ -178,7 +178,7 @@ TEST(HealthMonitor, LostForLongAsksForANewLocalMap) {
   HealthConfig config;
   config.lost_after_s = 0.5;
   config.reinitialize_after_s = 1.0;
-  HealthMonitor monitor(config, kGoodFitness_m2);
+  HealthMonitor monitor(config, kMaxFitness_m2);
   double t_s = warmUp(monitor, 10);
   const double last_ok_s = 9 * kPeriod_s;  // as warmUp stamped it
   bool asked = false;
@@ -188,7 +188,7 @@ TEST(HealthMonitor, LostForLongAsksForANewLocalMap) {
   }
   ASSERT_TRUE(asked);
   EXPECT_GT(t_s - kPeriod_s - last_ok_s, config.lost_after_s + config.reinitialize_after_s);
-  monitor.localMapRestarted();
+  monitor.localMapRestarted(t_s);
   EXPECT_FALSE(monitor.restartLocalMap());
   // The new map's first scan has nothing to register to; still lost until recovered.
   HealthEvidence seed = goodScan(t_s);

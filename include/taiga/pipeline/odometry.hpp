@@ -77,6 +77,9 @@ struct ScanOutcome {
   LidarFactor lidar = LidarFactor::kFirstScan;
   std::string lidar_note;  ///< why a factor was rejected or inflated
   registration::RegistrationResult registration;
+  /// How far the registration moved the body from the motion prior's prediction (translation m,
+  /// rotation deg); 0 without a registration.
+  double innovation_m = 0.0, innovation_deg = 0.0;
   std::size_t source_points = 0;
   ScanHealth health;
   /// The local map segment the scan belongs to: 0, and one more each time the odometry gave up
@@ -129,8 +132,13 @@ class Odometry {
  private:
   std::optional<ScanOutcome> processScan(const io::Scan& scan);
   ScanOutcome firstScanOutcome(FirstScan&& first);
+  /// Registration to the local map, from the prediction and, without an IMU, when that looks
+  /// wrong, from other headings too.
   registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
                                                  const lie::SE3& guess_T_odom_body);
+  /// One registration from one guess, with its fitness.
+  registration::RegistrationResult alignToMap(const std::vector<Eigen::Vector3d>& source,
+                                              const lie::SE3& guess_T_odom_body) const;
   void maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body);
   void judgeHealth(ScanOutcome& outcome, bool registered);
 
