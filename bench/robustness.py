@@ -6,7 +6,7 @@
 Per scenario and realism: the ATE (loop-closed, and the odometry alone) of every seed, its
 median, the end-point drift, scans whose lidar factor was rejected, and failures (a non-zero
 exit, or an ATE above 0.5 m: 10x the goal), and of those the silent ones (exit 0 and the health
-monitor's verdict ok or degraded; rows from before the monitor have no verdict: '-'). Where the ideal run of the same scenario and seed
+monitor's verdict ok, degraded or recovered; rows from before the monitor have no verdict: '-'). Where the ideal run of the same scenario and seed
 exists, the ATE is also given as a ratio to it.
 """
 import csv
@@ -40,7 +40,7 @@ def main():
                   if (scenario, r["seed"]) in ideal_ate and realism != "ideal"]
         failed = [r for r in rs if r["exit_code"] != "0" or not f(r["ate_m"]) < 0.5]
         with_health = all(r.get("health") not in (None, "", "nan") for r in rs)
-        silent = (str(sum(1 for r in failed if r["exit_code"] == "0" and r["health"] in ("ok", "degraded")))
+        silent = (str(sum(1 for r in failed if r["exit_code"] == "0" and r["health"] in ("ok", "degraded", "recovered")))
                   if with_health else "-")
         flagged = (f"{sum(int(f(r['scans_degraded'])) for r in rs)} / {sum(int(f(r['scans_lost'])) for r in rs)}"
                    if with_health else "-")

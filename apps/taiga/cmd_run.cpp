@@ -4,6 +4,7 @@
 #include <malloc.h>
 #endif
 
+#include <cmath>
 #include <memory>
 
 #include "command.hpp"
@@ -48,6 +49,13 @@ void printHealth(const pipeline::HealthReport& h) {
     fmt::print("           lost {:.1f}..{:.1f} s ({} scans): {}\n", stretch.from_s, stretch.to_s,
                stretch.scans, stretch.reason);
   }
+  if (std::isfinite(h.median_innovation_deg))
+    fmt::print("           IMU prediction vs registration: {:.2f} deg, {:.3f} m per scan (median){}\n",
+               h.median_innovation_deg, h.median_innovation_m,
+               h.calibration_suspect
+                   ? ": too far apart, the extrinsic rotation, time offset or IMU noise settings "
+                     "are suspect (docs/odometry.md, Health)"
+                   : "");
   if (h.trackLost())
     fmt::print(
         "           the track was lost and not re-attached: the trajectory and map after it are "

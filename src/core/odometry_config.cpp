@@ -33,8 +33,7 @@ void HealthConfig::visit(ConfigVisitor& v) {
           "s lost beyond lost_after_s after which the local map starts over from the next scan");
   v.field("recovery_scans", recovery_scans, "scans judged ok in a row that end a lost stretch");
   v.field("history_scans", history_scans,
-          "recent scans with a used lidar factor whose median fitness and inlier share are the "
-          "yardstick");
+          "recent ok scans whose median fitness and inlier share are the yardstick");
   v.field("fitness_ratio", fitness_ratio,
           "a scan whose fitness is above this many times the recent median is degraded");
   v.field("fitness_floor_m2", fitness_floor_m2,
@@ -48,6 +47,9 @@ void HealthConfig::visit(ConfigVisitor& v) {
           "m/s^2, an accelerometer bias estimate beyond this is implausible: degraded");
   v.field("max_gyro_bias_dps", max_gyro_bias_dps,
           "deg/s, a gyroscope bias estimate beyond this is implausible: degraded");
+  v.field("max_median_innovation_deg", max_median_innovation_deg,
+          "deg, with an IMU: a median rotation between the IMU prediction and the registration "
+          "above this over the run flags the rig's calibration or IMU noise settings as suspect");
 }
 
 void HealthConfig::validate() const {
@@ -63,6 +65,7 @@ void HealthConfig::validate() const {
   requirePositive("max_acceleration_mps2", max_acceleration_mps2, "m/s^2");
   requirePositive("max_accel_bias_mps2", max_accel_bias_mps2, "m/s^2");
   requirePositive("max_gyro_bias_dps", max_gyro_bias_dps, "deg/s");
+  requirePositive("max_median_innovation_deg", max_median_innovation_deg, "deg");
 }
 
 void OdometryConfig::visit(ConfigVisitor& v) {

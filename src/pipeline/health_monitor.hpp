@@ -54,10 +54,10 @@ class HealthMonitor {
   void forgetHistory();
 
  private:
-  /// Problems that, lasting, lose the track: a rejected or inflated lidar factor, a velocity
-  /// jump, implausible biases; `impossible` for a state no rig can have (lost at once).
+  /// Problems against fixed limits: a rejected or inflated lidar factor, a velocity jump,
+  /// implausible biases; `impossible` for a state no rig can have (lost at once).
   std::string seriousProblems(const HealthEvidence& scan, bool& impossible) const;
-  /// Fitness and inlier share far from the recent history: degraded, never lost by themselves.
+  /// Fitness and inlier share far from the recent history of ok scans.
   std::string relativeProblems(const HealthEvidence& scan) const;
   void remember(const HealthEvidence& scan);
 
@@ -67,15 +67,15 @@ class HealthMonitor {
     double fitness_m2 = 0.0;
     double inlier_share = 0.0;
   };
-  std::deque<Recent> history_;  ///< the latest used registrations, oldest first
-  std::optional<double> last_sound_t_s_;  ///< the latest scan without a serious problem
+  std::deque<Recent> history_;  ///< the latest ok scans' registrations, oldest first
+  std::optional<double> last_ok_t_s_;
   std::optional<double> previous_t_s_;
   Eigen::Vector3d previous_v_odom_ = Eigen::Vector3d::Zero();
   std::optional<double> lost_since_t_s_;
   /// Since when the track is lost on the current local map (the loss, or the last restart).
   std::optional<double> lost_on_this_map_since_t_s_;
   int ok_in_a_row_ = 0;
-  int serious_in_a_row_ = 0;
+  int not_ok_in_a_row_ = 0;
   bool restart_local_map_ = false;
 };
 

@@ -1,6 +1,7 @@
 #include "taiga/pipeline/odometry.hpp"
 
 #include <chrono>
+#include <cmath>
 
 #include "health_monitor.hpp"
 #include "lidar_factor.hpp"
@@ -19,6 +20,9 @@ using Clock = std::chrono::steady_clock;
 /// A wide-basin candidate replaces the registration only when it overlaps the map this much
 /// better: a near tie is the same basin seen through noise.
 constexpr double kClearlyBetter = 1.1;
+/// The share of a scan that must lie on the map for a wide-basin candidate to count when the
+/// map's scans have no history yet.
+constexpr double kMinOverlapWithoutHistory = 0.5;
 
 double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
   return source_points > 0
@@ -173,40 +177,40 @@ registration::RegistrationResult Odometry::registerToMap(const std::vector<Eigen
                                                          const lie::SE3& guess_T_odom_body) {
   local_map_.beginRegistration();
   registration::RegistrationResult result = alignToMap(source, guess_T_odom_body);
-  // Only against an established map: the overlap with a map of one or two scans tells nothing.
-  if (!lidar_only_ || !health_->hasYardstick() ||
-      !health_->registrationSuspect(result.fitness_m2, inlierShare(result, source.size())))
-    return result;
-  // A constant velocity is a poor prediction through a fast turn between sparse scans: the
-  // registration may have settled in a wrong basin. Start again from headings about the
-  // vertical around the prediction; keep the best overlap among the candidates that the health
-  // monitor would not find suspect themselves (a partial scan, e.g. most packets lost, makes no
-  // candidate look normal, and the first result stays) (docs/odometry.md, "Wide basin").
-  const double inlier_distance_m = config_.ndt_resolution_m;
+  if (!lidar_only_) return result;  // the IMU predicts within centimetres
+  // A constant velocity is a poor prediction through a fast turn between sparse scans, and none
+  // at all for the second scan (it knows no velocity yet): the registration may have settled in
+  // a wrong basin. Against an established map the health monitor's yardstick tells; on the first
+  // scans of a map there is none, so they always search (docs/odometry.md, "Wide basin").
+  const bool established = health_->hasYardstick();
+  const auto suspect = [&](const registration::RegistrationResult& r) {
+    if (established) return health_->registrationSuspect(r.fitness_m2, inlierShare(r, source.size()));
+    return !std::isfinite(r.fitness_m2) || r.fitness_m2 > config_.max_fitness_m2;
+  };
+  if (established && !suspect(result)) return result;
   const auto overlap = [&](const registration::RegistrationResult& r) {
     return registration::agreement(source, local_map_.kdTree(), r.T_target_source,
-                                   inlier_distance_m)
+                                   config_.ndt_resolution_m)
         .share;
   };
-  double best_overlap = overlap(result);
-  const double first_overlap = best_overlap;
-  int tries = 0;
+  const double first_overlap = overlap(result);
+  double best_overlap = first_overlap;
   for (const double yaw_deg : {-20.0, 20.0, -40.0, 40.0, -60.0, 60.0}) {
+    // Turned about the odom frame's vertical through the predicted position.
     const lie::SO3 turn = lie::SO3::fromRollPitchYaw(0.0, 0.0, yaw_deg * kRadPerDeg);
     const lie::SE3 guess(turn * guess_T_odom_body.rotation(), guess_T_odom_body.translation());
     registration::RegistrationResult candidate = alignToMap(source, guess);
-    ++tries;
-    if (health_->registrationSuspect(candidate.fitness_m2,
-                                     inlierShare(candidate, source.size())))
-      continue;
+    if (suspect(candidate)) continue;  // e.g. a partial scan: no candidate looks normal
     const double candidate_overlap = overlap(candidate);
+    // Without a yardstick, half the scan must lie on the map (a map seeded by a sliver of a scan
+    // offers no basin worth choosing).
+    if (!established && candidate_overlap < kMinOverlapWithoutHistory) continue;
     if (candidate_overlap > kClearlyBetter * best_overlap) {
       best_overlap = candidate_overlap;
       result = std::move(candidate);
     }
   }
-  logger().debug("wide-basin search: {} headings, overlap {:.2f} -> {:.2f}", tries, first_overlap,
-                 best_overlap);
+  logger().debug("wide-basin search: overlap {:.2f} -> {:.2f}", first_overlap, best_overlap);
   return result;
 }
 

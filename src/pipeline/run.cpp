@@ -134,7 +134,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   TrajectoryRecorder trajectories;
   ScanLog scan_log(out);
   GnssRecorder gnss(config);
-  HealthLog health;
+  HealthLog health(config.odometry.health);
   slam.addObserver(trajectories);
   slam.addObserver(scan_log);
   slam.addObserver(health);
@@ -149,7 +149,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);
   scan_log.fillSummary(summary);
-  summary.health = health.report();
+  summary.health = health.finish();
   if (trajectories.odometry().empty())
     throw InputError(fmt::format(
         "{}: no scan could be processed ({} scans, {} IMU samples): the odometry needs at least "

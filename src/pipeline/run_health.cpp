@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 
 #include "taiga/core/log.hpp"
+#include "taiga/core/percentile.hpp"
 
 namespace taiga::pipeline {
 
 std::string HealthReport::verdict() const {
   if (trackLost()) return "lost";
+  if (calibration_suspect) return "suspect";
   if (lost > 0) return "recovered";
   return degraded > 0 ? "degraded" : "ok";
 }
@@ -26,6 +28,11 @@ void HealthLog::onScan(const ScanOutcome& scan, const lie::SE3& /*T_map_odom*/) 
       break;
   }
   report_.map_segments = scan.map_segment + 1;
+  const bool with_imu = !scan.imu_rate_poses.empty();
+  if (with_imu && scan.lidar == LidarFactor::kUsed) {
+    innovations_deg_.push_back(scan.innovation_deg);
+    innovations_m_.push_back(scan.innovation_m);
+  }
   report_.ended_lost = h.status == ScanStatus::kLost;
   if (h.status != ScanStatus::kOk) {
     if (previous_ == h.status) {
@@ -43,6 +50,23 @@ void HealthLog::onScan(const ScanOutcome& scan, const lie::SE3& /*T_map_odom*/) 
   if (h.status == ScanStatus::kDegraded)
     logger().debug("scan {} at {:.3f} s degraded: {}", scan.scan_index, scan.t_s, h.reason);
   previous_ = h.status;
+}
+
+HealthReport HealthLog::finish() {
+  if (!innovations_deg_.empty()) {
+    report_.median_innovation_deg = percentile(innovations_deg_, 50.0);
+    report_.median_innovation_m = percentile(innovations_m_, 50.0);
+    report_.calibration_suspect =
+        report_.median_innovation_deg > config_.max_median_innovation_deg;
+    if (report_.calibration_suspect)
+      logger().warn(
+          "the IMU's prediction and the registration disagree by {:.2f} deg per scan (median; "
+          "above odometry.health.max_median_innovation_deg {:.2f}): the lidar-IMU extrinsic "
+          "rotation (rig.T_body_lidar), the time offset (rig.lidar_time_offset_s) or the IMU "
+          "noise settings are probably wrong, and the trajectory drifts for it",
+          report_.median_innovation_deg, config_.max_median_innovation_deg);
+  }
+  return report_;
 }
 
 std::string HealthLog::progressNote() const {

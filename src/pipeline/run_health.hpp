@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "taiga/pipeline/run.hpp"
 #include "taiga/pipeline/slam_system.hpp"
@@ -13,14 +14,18 @@ namespace taiga::pipeline {
 
 class HealthLog final : public SlamObserver {
  public:
+  explicit HealthLog(const HealthConfig& config) : config_(config) {}
   void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
+  /// The report, with the run's innovation statistics.
+  HealthReport finish();
 
   /// For the progress line: empty while ok, else e.g. "lost since 12.3 s".
   std::string progressNote() const;
-  const HealthReport& report() const { return report_; }
 
  private:
+  HealthConfig config_;
   HealthReport report_;
+  std::vector<double> innovations_deg_, innovations_m_;  ///< used lidar factors, with an IMU
   std::optional<ScanStatus> previous_;
 };
 

@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "run_outputs.hpp"
@@ -29,6 +30,10 @@ nlohmann::ordered_json gnssFusionJson(const mapping::GnssFusionReport& r) {
   return j;
 }
 
+nlohmann::ordered_json finiteOrNull(double value) {
+  return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json();
+}
+
 /// The health monitor's verdict and its stretches; degraded ones only the first few (scans.csv
 /// has every scan).
 nlohmann::ordered_json healthJson(const HealthReport& h) {
@@ -50,6 +55,9 @@ nlohmann::ordered_json healthJson(const HealthReport& h) {
           {"scans_lost", h.lost},
           {"map_segments", h.map_segments},
           {"ended_lost", h.ended_lost},
+          {"median_innovation_deg", finiteOrNull(h.median_innovation_deg)},
+          {"median_innovation_m", finiteOrNull(h.median_innovation_m)},
+          {"calibration_suspect", h.calibration_suspect},
           {"lost", lost},
           {"degraded_stretches", degraded_stretches},
           {"degraded", degraded}};

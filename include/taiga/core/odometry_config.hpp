@@ -31,8 +31,7 @@ struct HealthConfig final : ConfigSection {
   double reinitialize_after_s = 2.0;
   /// Scans judged ok in a row that end a lost stretch.
   int recovery_scans = 3;
-  /// Recent scans with a used lidar factor whose median fitness and inlier share are the
-  /// yardstick.
+  /// Recent ok scans whose median fitness and inlier share are the yardstick.
   int history_scans = 10;
   /// A fitness above this many times the recent median is degraded.
   double fitness_ratio = 4.0;
@@ -47,6 +46,9 @@ struct HealthConfig final : ConfigSection {
   /// Bias estimates beyond these are implausible for a working MEMS IMU: degraded.
   double max_accel_bias_mps2 = 1.5;
   double max_gyro_bias_dps = 10.0;
+  /// With an IMU: a median rotation between the IMU's prediction and the registration above this
+  /// over the run means the rig's calibration or noise settings are suspect, deg per scan.
+  double max_median_innovation_deg = 0.5;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

@@ -26,6 +26,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,9 +83,17 @@ struct HealthReport {
   std::size_t map_segments = 1;
   std::vector<HealthStretch> stretches;  ///< in time order
   bool ended_lost = false;
+  /// With an IMU: the median over the used lidar factors of how far the registration moved the
+  /// body from the IMU's prediction, and whether that exceeds
+  /// odometry.health.max_median_innovation_deg (a wrong extrinsic rotation or time offset, or
+  /// IMU noise settings far from the truth). NaN without an IMU.
+  double median_innovation_deg = std::numeric_limits<double>::quiet_NaN();
+  double median_innovation_m = std::numeric_limits<double>::quiet_NaN();
+  bool calibration_suspect = false;
   /// Lost and not re-attached to the same map: the run ended lost or started a new segment.
   bool trackLost() const { return ended_lost || map_segments > 1; }
-  /// "ok", "degraded", "recovered" (lost, then re-attached to the same map) or "lost".
+  /// "ok", "degraded", "recovered" (lost, then re-attached to the same map), "suspect" (the
+  /// calibration, see calibration_suspect) or "lost".
   std::string verdict() const;
 };
 
