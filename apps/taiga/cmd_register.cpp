@@ -112,13 +112,13 @@ std::string formatResult(const RegisterOptions& o, const registration::YawSearch
                        r.num_inliers, r.fitness_m2);
     out += fmt::format("overlap: {:.1f} % of the source within {} m of the target\n",
                        100.0 * search.overlap, registration::YawSearchOptions{}.inlier_distance_m);
-    out += fmt::format("yaw_hypotheses: {}{}\n", search.hypotheses,
-                       search.rival_overlap > 0.0
-                           ? fmt::format(" (best distinct rival: {:.1f} % overlap, {:.2f} m / "
-                                         "{:.1f} deg away)",
-                                         100.0 * search.rival_overlap, search.rival_m,
-                                         search.rival_deg)
-                           : std::string());
+    out += fmt::format(
+        "yaw_hypotheses: {}{}\n", search.hypotheses,
+        search.rival_overlap > 0.0
+            ? fmt::format(" (best distinct rival: {:.1f} % overlap, {:.2f} m / "
+                          "{:.1f} deg away)",
+                          100.0 * search.rival_overlap, search.rival_m, search.rival_deg)
+            : std::string());
     out +=
         fmt::format("hessian_condition: {:.4g}\ntime_ms: {:.1f}\n", r.hessian_condition, time_ms);
   }

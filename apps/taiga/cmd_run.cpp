@@ -50,12 +50,13 @@ void printHealth(const pipeline::HealthReport& h) {
                stretch.scans, stretch.reason);
   }
   if (std::isfinite(h.median_innovation_deg))
-    fmt::print("           IMU prediction vs registration: {:.2f} deg, {:.3f} m per scan (median){}\n",
-               h.median_innovation_deg, h.median_innovation_m,
-               h.calibration_suspect
-                   ? ": too far apart, the extrinsic rotation, time offset or IMU noise settings "
-                     "are suspect (docs/odometry.md, Health)"
-                   : "");
+    fmt::print(
+        "           IMU prediction vs registration: {:.2f} deg, {:.3f} m per scan (median){}\n",
+        h.median_innovation_deg, h.median_innovation_m,
+        h.calibration_suspect
+            ? ": too far apart, the extrinsic rotation, time offset or IMU noise settings "
+              "are suspect (docs/odometry.md, Health)"
+            : "");
   if (h.trackLost())
     fmt::print(
         "           the track was lost and not re-attached: the trajectory and map after it are "

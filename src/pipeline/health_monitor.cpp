@@ -31,18 +31,6 @@ double medianOf(const std::deque<Field>& history, double Field::*member) {
 
 }  // namespace
 
-const char* scanStatusName(ScanStatus status) {
-  switch (status) {
-    case ScanStatus::kOk:
-      return "ok";
-    case ScanStatus::kDegraded:
-      return "degraded";
-    case ScanStatus::kLost:
-      return "lost";
-  }
-  return "?";
-}
-
 std::string HealthMonitor::relativeProblems(const HealthEvidence& scan) const {
   if (!scan.registered || scan.lidar != LidarFactor::kUsed || history_.size() < kMinHistory)
     return {};
@@ -50,9 +38,9 @@ std::string HealthMonitor::relativeProblems(const HealthEvidence& scan) const {
   const double median_fitness_m2 = medianOf(history_, &Recent::fitness_m2);
   if (scan.fitness_m2 > config_.fitness_floor_m2 &&
       scan.fitness_m2 > config_.fitness_ratio * median_fitness_m2)
-    append(reasons, fmt::format("fitness {:.3f} m^2 is {:.1f}x the recent median {:.3f}",
-                                scan.fitness_m2, scan.fitness_m2 / median_fitness_m2,
-                                median_fitness_m2));
+    append(reasons,
+           fmt::format("fitness {:.3f} m^2 is {:.1f}x the recent median {:.3f}", scan.fitness_m2,
+                       scan.fitness_m2 / median_fitness_m2, median_fitness_m2));
   const double median_share = medianOf(history_, &Recent::inlier_share);
   if (scan.inlier_share < config_.inlier_share_ratio * median_share)
     append(reasons, fmt::format("{:.0f} % of the points matched the map, recently {:.0f} %",

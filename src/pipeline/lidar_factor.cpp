@@ -30,8 +30,8 @@ std::string rejection(const registration::RegistrationResult& r,
 /// (eigenvalue below the largest / max_condition), where the prediction stands. `dropped` gets
 /// the number of directions dropped.
 lie::SE3 keepConstrainedDirections(const lie::SE3& predicted_T_odom_body,
-                                   const registration::RegistrationResult& r,
-                                   double max_condition, int& dropped) {
+                                   const registration::RegistrationResult& r, double max_condition,
+                                   int& dropped) {
   const Eigen::SelfAdjointEigenSolver<lie::Matrix6> eigen(r.hessian);
   const lie::Vector6 step = (predicted_T_odom_body.inverse() * r.T_target_source).Log();
   const double floor = eigen.eigenvalues().maxCoeff() / max_condition;
@@ -77,10 +77,10 @@ LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
     // Without an IMU the prediction is a constant velocity and the measurement is taken as the
     // state whatever its covariance: the degenerate directions keep the prediction instead.
     int dropped = 0;
-    T_odom_body = keepConstrainedDirections(predicted_T_odom_body, r,
-                                            config.degenerate_condition, dropped);
-    verdict.note += fmt::format("; the prediction kept along {} direction{}", dropped,
-                                dropped == 1 ? "" : "s");
+    T_odom_body =
+        keepConstrainedDirections(predicted_T_odom_body, r, config.degenerate_condition, dropped);
+    verdict.note +=
+        fmt::format("; the prediction kept along {} direction{}", dropped, dropped == 1 ? "" : "s");
   }
   const LidarSigmas sigma = config.lidarSigmas(r.fitness_m2, inflation);
   const Eigen::Matrix3d R_odom_body = T_odom_body.rotation().matrix();

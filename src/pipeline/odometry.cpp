@@ -25,9 +25,8 @@ constexpr double kClearlyBetter = 1.1;
 constexpr double kMinOverlapWithoutHistory = 0.5;
 
 double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
-  return source_points > 0
-             ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
-             : 0.0;
+  return source_points > 0 ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
+                           : 0.0;
 }
 
 double msSince(Clock::time_point start) {
@@ -54,6 +53,18 @@ const char* lidarFactorName(LidarFactor factor) {
       return "inflated";
     case LidarFactor::kRejected:
       return "rejected";
+  }
+  return "?";
+}
+
+const char* scanStatusName(ScanStatus status) {
+  switch (status) {
+    case ScanStatus::kOk:
+      return "ok";
+    case ScanStatus::kDegraded:
+      return "degraded";
+    case ScanStatus::kLost:
+      return "lost";
   }
   return "?";
 }
@@ -184,7 +195,8 @@ registration::RegistrationResult Odometry::registerToMap(const std::vector<Eigen
   // scans of a map there is none, so they always search (docs/odometry.md, "Wide basin").
   const bool established = health_->hasYardstick();
   const auto suspect = [&](const registration::RegistrationResult& r) {
-    if (established) return health_->registrationSuspect(r.fitness_m2, inlierShare(r, source.size()));
+    if (established)
+      return health_->registrationSuspect(r.fitness_m2, inlierShare(r, source.size()));
     return !std::isfinite(r.fitness_m2) || r.fitness_m2 > config_.max_fitness_m2;
   };
   if (established && !suspect(result)) return result;
@@ -242,16 +254,15 @@ registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::V
 
 void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
   const registration::RegistrationResult& r = outcome.registration;
-  outcome.health = health_->judge(
-      {.t_s = outcome.t_s,
-       .registered = registered,
-       .lidar = outcome.lidar,
-       .lidar_note = outcome.lidar_note,
-       .fitness_m2 = r.fitness_m2,
-       .inlier_share = inlierShare(r, outcome.source_points),
-       .v_odom = outcome.v_odom,
-       .bias = outcome.bias,
-       .estimates_bias = !lidar_only_});
+  outcome.health = health_->judge({.t_s = outcome.t_s,
+                                   .registered = registered,
+                                   .lidar = outcome.lidar,
+                                   .lidar_note = outcome.lidar_note,
+                                   .fitness_m2 = r.fitness_m2,
+                                   .inlier_share = inlierShare(r, outcome.source_points),
+                                   .v_odom = outcome.v_odom,
+                                   .bias = outcome.bias,
+                                   .estimates_bias = !lidar_only_});
   if (health_->restartLocalMap()) {
     // Lost for long: the old local map no longer explains the scans. A new segment starts with
     // this scan, placed by dead reckoning (docs/odometry.md, "Health").

@@ -142,9 +142,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
 
   RunSummary summary;
   const auto wall_start = Clock::now();
-  summary.scans =
-      feedRecording(recording, std::move(read_ahead), options, slam, scan_log, health,
-                    summary.realtime);
+  summary.scans = feedRecording(recording, std::move(read_ahead), options, slam, scan_log, health,
+                                summary.realtime);
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);

@@ -56,8 +56,7 @@ HealthReport HealthLog::finish() {
   if (!innovations_deg_.empty()) {
     report_.median_innovation_deg = percentile(innovations_deg_, 50.0);
     report_.median_innovation_m = percentile(innovations_m_, 50.0);
-    report_.calibration_suspect =
-        report_.median_innovation_deg > config_.max_median_innovation_deg;
+    report_.calibration_suspect = report_.median_innovation_deg > config_.max_median_innovation_deg;
     if (report_.calibration_suspect)
       logger().warn(
           "the IMU's prediction and the registration disagree by {:.2f} deg per scan (median; "

@@ -55,7 +55,8 @@ ScanLog::ScanLog(const std::filesystem::path& dir)
     : timing_(openOutput(dir / "timing.csv")), scans_(openOutput(dir / "scans.csv")) {
   timing_ << "t_s,read_ms,deskew_ms,filter_ms,registration_ms,optimization_ms,map_ms,total_ms\n";
   scans_ << "t_s,scan,lidar_factor,fitness_m2,iterations,converged,inliers,hessian_condition,"
-            "source_points,keyframe,note,status,health_reason,map_segment,innovation_m,innovation_deg\n";
+            "source_points,keyframe,note,status,health_reason,map_segment,innovation_m,innovation_"
+            "deg\n";
 }
 
 void ScanLog::chargeReadTime(std::uint64_t scan_index, double read_ms) {
@@ -75,12 +76,12 @@ void ScanLog::onScan(const ScanOutcome& scan, const lie::SE3& /*T_map_odom*/) {
                          read_ms, t.deskew_ms, t.filter_ms, t.registration_ms, t.optimization_ms,
                          t.map_ms, t.total_ms);
   const registration::RegistrationResult& r = scan.registration;
-  scans_ << fmt::format("{:.6f},{},{},{:.5f},{},{},{},{:.4g},{},{},\"{}\",{},\"{}\",{},{:.4f},{:.3f}\n",
-                        scan.t_s, scan.scan_index, lidarFactorName(scan.lidar), r.fitness_m2,
-                        r.iterations, r.converged ? 1 : 0, r.num_inliers, r.hessian_condition,
-                        scan.source_points, scan.keyframe_id ? 1 : 0, scan.lidar_note,
-                        scanStatusName(scan.health.status), scan.health.reason, scan.map_segment,
-                        scan.innovation_m, scan.innovation_deg);
+  scans_ << fmt::format(
+      "{:.6f},{},{},{:.5f},{},{},{},{:.4g},{},{},\"{}\",{},\"{}\",{},{:.4f},{:.3f}\n", scan.t_s,
+      scan.scan_index, lidarFactorName(scan.lidar), r.fitness_m2, r.iterations, r.converged ? 1 : 0,
+      r.num_inliers, r.hessian_condition, scan.source_points, scan.keyframe_id ? 1 : 0,
+      scan.lidar_note, scanStatusName(scan.health.status), scan.health.reason, scan.map_segment,
+      scan.innovation_m, scan.innovation_deg);
 }
 
 void ScanLog::onKeyframe(std::uint64_t /*id*/, const ScanOutcome& /*scan*/) { ++keyframes_; }

@@ -46,8 +46,8 @@ nlohmann::ordered_json healthJson(const HealthReport& h) {
     degraded_stretches += !is_lost;
     if (!is_lost && degraded.size() >= kListedDegraded) continue;
     (is_lost ? lost : degraded)
-        .push_back({{"from_s", s.from_s}, {"to_s", s.to_s}, {"scans", s.scans},
-                    {"reason", s.reason}});
+        .push_back(
+            {{"from_s", s.from_s}, {"to_s", s.to_s}, {"scans", s.scans}, {"reason", s.reason}});
   }
   return {{"verdict", h.verdict()},
           {"scans_ok", h.ok},

@@ -37,7 +37,8 @@ HealthEvidence rejectedScan(double t_s) {
 
 /// Feeds `n` good scans from t = 0; returns the next scan's time.
 double warmUp(HealthMonitor& monitor, int n) {
-  for (int k = 0; k < n; ++k) EXPECT_EQ(monitor.judge(goodScan(k * kPeriod_s)).status, ScanStatus::kOk);
+  for (int k = 0; k < n; ++k)
+    EXPECT_EQ(monitor.judge(goodScan(k * kPeriod_s)).status, ScanStatus::kOk);
   return n * kPeriod_s;
 }
 

@@ -23,8 +23,8 @@ io::Scan scanAt(const std::vector<Eigen::Vector3d>& world, std::uint64_t index,
                 const lie::SE3& T_world_body) {
   const double t_end_s = 1.0 + kScanPeriod_s * static_cast<double>(index);
   io::Scan scan{.index = index, .t_start_s = t_end_s, .t_end_s = t_end_s};
-  scan.cloud_in_lidar = forest::scanInBody(world, T_world_body, static_cast<unsigned>(index) + 7,
-                                           25.0, 0.6);
+  scan.cloud_in_lidar =
+      forest::scanInBody(world, T_world_body, static_cast<unsigned>(index) + 7, 25.0, 0.6);
   scan.cloud_in_lidar.times_s.assign(scan.cloud_in_lidar.size(), t_end_s);
   return scan;
 }
@@ -75,7 +75,8 @@ TEST(OdometryHealth, ACleanWalkIsOkThroughout) {
 }
 
 TEST(OdometryHealth, AScanFromAnotherPlaceIsNotOkAndNeverAKeyframe) {
-  const std::vector<Eigen::Vector3d> elsewhere = forest::forestInWorld(11, {.ground_spacing_m = 0.25});
+  const std::vector<Eigen::Vector3d> elsewhere =
+      forest::forestInWorld(11, {.ground_spacing_m = 0.25});
   constexpr int kSpliced = 20;
   const Walk w = walk(40, [&](int k, std::uint64_t index) {
     if (k != kSpliced) return std::optional<io::Scan>();

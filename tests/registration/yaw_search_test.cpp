@@ -17,23 +17,36 @@ lie::SE3 yawTurn(double deg) {
   return lie::SE3(lie::SO3::fromRollPitchYaw(0.0, 0.0, deg * kRadPerDeg), Eigen::Vector3d::Zero());
 }
 
-TEST(YawSearch, TheRealPairTurnedThirtyToSixtyDegreesIsFoundOrReportedNeverWrong) {
-  const std::vector<Eigen::Vector3d> source =
+/// The real pair, the source voxelized as `taiga register` does, and NDT coarse to fine from 4 m.
+struct RealPair {
+  std::vector<Eigen::Vector3d> source =
       voxelDownsample(test::loadPositions(test::kRegistrationData / "source.ply"), 0.25);
-  const std::vector<Eigen::Vector3d> target =
-      test::loadPositions(test::kRegistrationData / "target.ply");
-  const lie::SE3 reference = test::loadTransform(test::kRegistrationData / "T_target_source.txt");
-  RegistrationConfig config;
-  config.ndt.coarse_resolutions_m = {4.0, 2.0};
+  std::vector<Eigen::Vector3d> target = test::loadPositions(test::kRegistrationData / "target.ply");
+  lie::SE3 reference = test::loadTransform(test::kRegistrationData / "T_target_source.txt");
+  RegistrationConfig config = [] {
+    RegistrationConfig c;
+    c.ndt.coarse_resolutions_m = {4.0, 2.0};
+    return c;
+  }();
+
+  /// The source turned by `turn`: its points are turn * p, so T_target_turned = T * turn^-1.
+  std::vector<Eigen::Vector3d> turned(const lie::SE3& turn) const {
+    std::vector<Eigen::Vector3d> points;
+    for (const Eigen::Vector3d& p : source) points.push_back(turn * p);
+    return points;
+  }
+};
+
+TEST(YawSearch, TheRealPairTurnedThirtyToSixtyDegreesIsFoundOrReportedNeverWrong) {
+  const RealPair pair;
   int found = 0;
   for (int k = 0; k < 20; ++k) {
     const double deg = (k % 2 ? -1.0 : 1.0) * (30.0 + 30.0 * k / 19.0);
-    // The source turned by `deg`: its points are turn * p, so T_target_turned = T * turn^-1.
     const lie::SE3 turn = yawTurn(deg);
-    std::vector<Eigen::Vector3d> turned;
-    for (const Eigen::Vector3d& p : source) turned.push_back(turn * p);
-    const YawSearchResult r = registerWithYawSearch(turned, target, lie::SE3(), config);
-    const test::PoseError e = test::poseError(r.best.T_target_source, reference * turn.inverse());
+    const YawSearchResult r =
+        registerWithYawSearch(pair.turned(turn), pair.target, lie::SE3(), pair.config);
+    const test::PoseError e =
+        test::poseError(r.best.T_target_source, pair.reference * turn.inverse());
     const bool right = e.translation_m < 0.05 && e.rotation_deg < 0.5;
     EXPECT_TRUE(right || !r.best.converged)
         << deg << " deg: converged to a pose " << e.translation_m << " m / " << e.rotation_deg
@@ -46,19 +59,11 @@ TEST(YawSearch, TheRealPairTurnedThirtyToSixtyDegreesIsFoundOrReportedNeverWrong
 
 TEST(YawSearch, FromOneHeadingAFarTurnIsWrongThatIsWhyItSearches) {
   // The failure this guards against: a single start 60 deg off settles in a wrong basin.
-  const std::vector<Eigen::Vector3d> source =
-      voxelDownsample(test::loadPositions(test::kRegistrationData / "source.ply"), 0.25);
-  const std::vector<Eigen::Vector3d> target =
-      test::loadPositions(test::kRegistrationData / "target.ply");
-  const lie::SE3 reference = test::loadTransform(test::kRegistrationData / "T_target_source.txt");
-  RegistrationConfig config;
-  config.ndt.coarse_resolutions_m = {4.0, 2.0};
+  const RealPair pair;
   const lie::SE3 turn = yawTurn(60.0);
-  std::vector<Eigen::Vector3d> turned;
-  for (const Eigen::Vector3d& p : source) turned.push_back(turn * p);
-  const YawSearchResult one =
-      registerWithYawSearch(turned, target, lie::SE3(), config, {.hypotheses = 1});
-  EXPECT_GT(test::poseError(one.best.T_target_source, reference * turn.inverse()).rotation_deg,
+  const YawSearchResult one = registerWithYawSearch(pair.turned(turn), pair.target, lie::SE3(),
+                                                    pair.config, {.hypotheses = 1});
+  EXPECT_GT(test::poseError(one.best.T_target_source, pair.reference * turn.inverse()).rotation_deg,
             5.0);
 }
 
