@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "taiga/core/errors.hpp"
@@ -13,23 +14,25 @@ namespace {
 
 /// The --t-offset (added to the estimate's stamps, as evo's) that would make the stamps match:
 /// the start difference when the spans do not overlap, then the median gap from each estimate
-/// stamp to its nearest reference stamp (e.g. half a scan when one is stamped at scan start and
-/// the other at scan end).
+/// stamp to the reference stamp before it or to the one after it, whichever median is smaller
+/// (e.g. half a scan when one is stamped at the scan's start and the other at its end; at
+/// exactly half a period both match, and the one before is taken).
 double suggestedTimeOffset(const Trajectory& est, const Trajectory& ref) {
   const bool overlap = est.startTime() <= ref.endTime() && ref.startTime() <= est.endTime();
   const double shift_s = overlap ? 0.0 : ref.startTime() - est.startTime();
   std::vector<double> ref_s;
   for (const StampedPose& p : ref.poses()) ref_s.push_back(p.t_s);
-  std::vector<double> gaps_s;
+  std::vector<double> to_before_s, to_after_s;
   for (const StampedPose& p : est.poses()) {
     const double t_s = p.t_s + shift_s;
-    const auto upper = std::lower_bound(ref_s.begin(), ref_s.end(), t_s);
-    double gap_s = upper == ref_s.end() ? ref_s.back() - t_s : *upper - t_s;
-    if (upper != ref_s.begin() && std::abs(*(upper - 1) - t_s) < std::abs(gap_s))
-      gap_s = *(upper - 1) - t_s;
-    gaps_s.push_back(gap_s);
+    const auto after = std::lower_bound(ref_s.begin(), ref_s.end(), t_s);
+    if (after != ref_s.end()) to_after_s.push_back(*after - t_s);
+    if (after != ref_s.begin()) to_before_s.push_back(*(after - 1) - t_s);
   }
-  return shift_s + percentile(gaps_s, 50.0);
+  if (to_before_s.empty()) return shift_s + percentile(to_after_s, 50.0);
+  if (to_after_s.empty()) return shift_s + percentile(to_before_s, 50.0);
+  const double before_s = percentile(to_before_s, 50.0), after_s = percentile(to_after_s, 50.0);
+  return shift_s + (std::abs(before_s) <= std::abs(after_s) ? before_s : after_s);
 }
 
 }  // namespace

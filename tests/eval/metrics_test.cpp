@@ -1,5 +1,6 @@
 // APE, RPE, KITTI errors, drift, distance distribution and statistics on hand-computed cases.
 #include <gmock/gmock.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -206,6 +207,18 @@ TEST(Evaluate, NoMatchingStampsIsAnInputErrorNamingTheTolerance) {
   const Trajectory est(test::curvedPath(10, 200.0));
   EXPECT_THAT(taiga::test::messageOf<InputError>([&] { evaluate(est, ref, {}); }),
               ::testing::HasSubstr("no matching time stamps"));
+  // The spans do not overlap: the offset that matches the starts.
+  EXPECT_THAT(taiga::test::messageOf<InputError>([&] { evaluate(est, ref, {}); }),
+              ::testing::HasSubstr("--t-offset -100.000000 would make them match"));
+  // Stamped 30 ms late: 30 ms back; half a period late (scan end against scan start): both
+  // neighbours match, the one before is taken.
+  for (const double late_s : {0.03, 0.05}) {
+    std::vector<StampedPose> shifted = test::curvedPath(10, 100.0);
+    for (StampedPose& p : shifted) p.t_s += late_s;
+    EXPECT_THAT(
+        taiga::test::messageOf<InputError>([&] { evaluate(Trajectory(shifted), ref, {}); }),
+        ::testing::HasSubstr(fmt::format("--t-offset {:.6f} would make them match", -late_s)));
+  }
 }
 
 }  // namespace
