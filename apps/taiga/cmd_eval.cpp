@@ -26,6 +26,7 @@ struct EvalOptions {
   double t_max_diff_s = 0.01;
   double t_offset_s = 0.0;
   std::string timing;
+  std::string scans;
   double scan_period_s = 0.1;
   std::string plots;
   bool distance = false;
@@ -80,6 +81,10 @@ int runEval(const EvalOptions& options) {
     report.map_file = options.map;
     report.scene_dir = options.scene;
     report.map_sharpness = mapSharpness(options, report.result.transform);
+  }
+  if (!options.scans.empty()) {
+    report.scans_file = options.scans;
+    report.ape_by_status = eval::apeByStatus(report.result, eval::readScanStatuses(options.scans));
   }
   if (!options.timing.empty()) {
     report.timing_file = options.timing;
@@ -142,6 +147,9 @@ Command addEvalCommand(CLI::App& tool) {
       ->capture_default_str();
   parser->add_option("--timing", options->timing,
                      "timing.csv of the run: processing time statistics");
+  parser->add_option("--scans", options->scans,
+                     "scans.csv of the run: the APE of the poses of ok, degraded and lost scans "
+                     "apart (docs/odometry.md, Health)");
   parser
       ->add_option("--scan-period-s", options->scan_period_s,
                    "Sensor period for the timing statistics, s")

@@ -58,6 +58,12 @@ std::string formatEvalJson(const EvalReport& report) {
                    {"first_bin_start_m", d.first_bin_start_m},
                    {"counts", d.counts}};
   if (report.timing) j["timing"] = detail::timingJson(*report.timing, report.timing_file);
+  if (report.ape_by_status) {
+    json by_status = json::object();
+    for (const StatusApe& s : *report.ape_by_status)
+      by_status[s.status] = {{"poses", s.poses}, {"rmse_m", s.rmse_m}, {"max_m", s.max_m}};
+    j["ape_by_status"] = {{"scans", report.scans_file}, {"statuses", by_status}};
+  }
   if (report.map_sharpness) {
     const MapSharpness& m = *report.map_sharpness;
     j["map_sharpness"] = {{"map", report.map_file},

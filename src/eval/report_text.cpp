@@ -91,6 +91,12 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
                                 m.mean_m, m.median_m, m.p95_m, m.cap_m,
                                 100.0 * m.fraction_beyond_cap)});
   }
+  if (report.ape_by_status) {
+    for (const StatusApe& s : *report.ape_by_status)
+      rows.push_back({fmt::format("APE of {} scans (m)", s.status),
+                      fmt::format("rmse {:.6f}  max {:.6f}  ({} poses, {})", s.rmse_m, s.max_m,
+                                  s.poses, report.scans_file)});
+  }
   if (report.timing) {
     const TimingStatistics& t = *report.timing;
     for (const StageTiming& s : t.stages)

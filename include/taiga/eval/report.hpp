@@ -6,6 +6,7 @@
 #include <string>
 
 #include "taiga/eval/evaluate.hpp"
+#include "taiga/eval/health_split.hpp"
 #include "taiga/eval/map_sharpness.hpp"
 #include "taiga/eval/timing.hpp"
 
@@ -22,6 +23,9 @@ struct EvalReport {
   /// `--map MAP --scene RECORDING`: the map's distance to the true surfaces (map_sharpness.hpp).
   std::optional<MapSharpness> map_sharpness;
   std::string map_file, scene_dir;
+  /// `--scans RUN/scans.csv`: the APE by the health status of each pose's scan.
+  std::optional<std::vector<StatusApe>> ape_by_status;
+  std::string scans_file;
 };
 
 /// Statistics with 6 decimals, as evo prints them.
