@@ -31,7 +31,7 @@ double medianOf(const std::deque<Field>& history, double Field::*member) {
 
 }  // namespace
 
-std::string HealthMonitor::relativeProblems(const HealthEvidence& scan) const {
+std::string HealthMonitor::historyProblems(const HealthEvidence& scan) const {
   if (!scan.registered || scan.lidar != LidarFactor::kUsed || history_.size() < kMinHistory)
     return {};
   std::string reasons;
@@ -48,7 +48,7 @@ std::string HealthMonitor::relativeProblems(const HealthEvidence& scan) const {
   return reasons;
 }
 
-std::string HealthMonitor::seriousProblems(const HealthEvidence& scan, bool& impossible) const {
+std::string HealthMonitor::limitProblems(const HealthEvidence& scan, bool& impossible) const {
   std::string reasons;
   const double speed_mps = scan.v_odom.norm();
   impossible = !scan.v_odom.allFinite() || speed_mps > config_.max_speed_mps;
@@ -91,8 +91,8 @@ ScanHealth HealthMonitor::judge(const HealthEvidence& scan) {
   if (!last_ok_t_s_) last_ok_t_s_ = scan.t_s;  // the first scan starts the clock
   bool impossible = false;
   ScanHealth health;
-  append(health.reason, seriousProblems(scan, impossible));
-  append(health.reason, relativeProblems(scan));
+  append(health.reason, limitProblems(scan, impossible));
+  append(health.reason, historyProblems(scan));
   const bool good = health.reason.empty();
   previous_t_s_ = scan.t_s;
   previous_v_odom_ = scan.v_odom;
@@ -132,7 +132,7 @@ bool HealthMonitor::hasYardstick() const { return history_.size() >= kMinHistory
 
 bool HealthMonitor::registrationSuspect(double fitness_m2, double inlier_share) const {
   if (!std::isfinite(fitness_m2) || fitness_m2 > max_fitness_m2_) return true;
-  return !relativeProblems({.registered = true,
+  return !historyProblems({.registered = true,
                             .lidar = LidarFactor::kUsed,
                             .fitness_m2 = fitness_m2,
                             .inlier_share = inlier_share})

@@ -56,9 +56,9 @@ class HealthMonitor {
  private:
   /// Problems against fixed limits: a rejected or inflated lidar factor, a velocity jump,
   /// implausible biases; `impossible` for a state no rig can have (lost at once).
-  std::string seriousProblems(const HealthEvidence& scan, bool& impossible) const;
+  std::string limitProblems(const HealthEvidence& scan, bool& impossible) const;
   /// Fitness and inlier share far from the recent history of ok scans.
-  std::string relativeProblems(const HealthEvidence& scan) const;
+  std::string historyProblems(const HealthEvidence& scan) const;
   void remember(const HealthEvidence& scan);
 
   HealthConfig config_;
