@@ -175,7 +175,7 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   }
   outcome.timing.optimization_ms = msSince(stage);
 
-  // 7. Health; 8. keyframe.
+  // 7. Health, then the keyframe test.
   stage = Clock::now();
   judgeHealth(outcome, has_map);
   maybeAddKeyframe(outcome, cloud_in_body);

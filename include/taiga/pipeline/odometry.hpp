@@ -13,8 +13,8 @@
 //      covariance (thesis Eq. 36)
 //   6. fuse: the motion prior's state with the lidar factor (IMU: fixed-lag smoothing of the
 //      IMU and lidar factors -> pose, velocity, biases)
-//   7. health (health_monitor.hpp): ok, degraded or lost, against the run's own recent history
-//   8. keyframe test (thesis Eq. 37): an ok scan joins the local map
+//   7. health (health_monitor.hpp: ok, degraded or lost, against fixed limits and the run's own
+//      recent history), then the keyframe test (thesis Eq. 37): an ok scan joins the local map
 //
 // With an IMU the odom frame is levelled once, gravity_alignment_s into the run (motion_prior.hpp):
 // the scan that levels it carries T_odom_unlevelled, and the earlier outcomes are in the
