@@ -43,8 +43,8 @@ class HealthMonitor {
   /// Whether the recent history is long enough to judge against (not right after the local map
   /// started over).
   bool hasYardstick() const;
-  /// True when the scan just judged asks for a fresh local map: lost for longer than
-  /// reinitialize_after_s, with no sign that the old one still fits.
+  /// True when the scan just judged asks for a fresh local map: lost on the current one for
+  /// longer than reinitialize_after_s.
   bool restartLocalMap() const { return restart_local_map_; }
   /// The local map was restarted after a loss: the next scans rebuild the history and start the
   /// clock anew.

@@ -67,10 +67,6 @@ LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
                        ? "registration hit its iteration limit"
                        : fmt::format("degenerate: Hessian condition {:.3g}", r.hessian_condition);
   }
-  // Roll and pitch keep sigma_sm: gravity in the IMU factor observes them, and a tighter lidar
-  // factor would hold on to a tilted local map. Heading has no such second source, so it gets its
-  // own, tighter sigma (docs/odometry.md). The factor's rotation tangent is in the body frame:
-  // Sigma_body = R^T Sigma_odom R.
   lie::SE3 T_odom_body = r.T_target_source;
   if (!check_jump && r.hessian_condition > config.degenerate_condition &&
       std::isfinite(r.hessian_condition)) {
@@ -82,6 +78,10 @@ LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
     verdict.note +=
         fmt::format("; the prediction kept along {} direction{}", dropped, dropped == 1 ? "" : "s");
   }
+  // Roll and pitch keep sigma_sm: gravity in the IMU factor observes them, and a tighter lidar
+  // factor would hold on to a tilted local map. Heading has no such second source, so it gets its
+  // own, tighter sigma (docs/odometry.md). The factor's rotation tangent is in the body frame:
+  // Sigma_body = R^T Sigma_odom R.
   const LidarSigmas sigma = config.lidarSigmas(r.fitness_m2, inflation);
   const Eigen::Matrix3d R_odom_body = T_odom_body.rotation().matrix();
   const Eigen::Vector3d rotation_variances_odom(sigma.tilt_rad * sigma.tilt_rad,
