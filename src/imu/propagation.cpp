@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "taiga/imu/readings.hpp"
+
 namespace taiga::imu {
 
 NavState propagate(const NavState& state, const Vector3& accel_body_mps2,
@@ -21,28 +23,18 @@ std::vector<StampedNavState> propagateThrough(const NavState& start, double t_st
   if (samples.empty()) throw std::invalid_argument("propagateThrough: no IMU samples");
   if (t_end_s < t_start_s)
     throw std::invalid_argument("propagateThrough: t_end_s before t_start_s");
-  // The reading in force at t_start_s: the latest sample at or before it, else the first one.
-  auto in_force = std::upper_bound(samples.begin(), samples.end(), t_start_s,
-                                   [](double t, const ImuSample& s) { return t < s.t_s; });
-  if (in_force != samples.begin()) --in_force;
-
   std::vector<StampedNavState> states{{t_start_s, start}};
-  double t = t_start_s;
-  NavState state = start;
-  while (t < t_end_s) {
-    auto next = std::next(in_force);
-    const double t_next =
-        (next != samples.end() && next->t_s < t_end_s) ? std::max(next->t_s, t) : t_end_s;
-    if (t_next > t) {
-      state = propagate(state, in_force->acceleration_imu_mps2 - bias.accel_mps2,
-                        in_force->angular_velocity_imu_radps - bias.gyro_radps, t_next - t,
-                        gravity_world);
-      t = t_next;
-      states.push_back({t, state});
-    }
-    if (next == samples.end() || next->t_s >= t_end_s) break;
-    in_force = next;
-  }
+  using Reading = Eigen::Matrix<double, 6, 1>;  // [acceleration; angular velocity]
+  forEachPiece(
+      samples, t_start_s, t_end_s,
+      [](const ImuSample& s) {
+        return (Reading() << s.acceleration_imu_mps2, s.angular_velocity_imu_radps).finished();
+      },
+      [&](double t_from_s, double t_to_s, const Reading& mean) {
+        states.push_back({t_to_s, propagate(states.back().state, mean.head<3>() - bias.accel_mps2,
+                                            mean.tail<3>() - bias.gyro_radps, t_to_s - t_from_s,
+                                            gravity_world)});
+      });
   return states;
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "taiga/imu/readings.hpp"
+
 namespace taiga::pipeline {
 namespace {
 
@@ -31,20 +33,28 @@ std::vector<ImuSample> ImuBuffer::between(double t_from_s, double t_to_s) const 
   return out;
 }
 
+std::vector<ImuSample> ImuBuffer::signalOver(double t_from_s, double t_to_s) const {
+  std::vector<ImuSample> out = between(t_from_s, t_to_s);
+  const auto after = std::upper_bound(samples_.begin(), samples_.end(), t_to_s,
+                                      [](double t, const ImuSample& s) { return t < s.t_s; });
+  if (after != samples_.end() && (out.empty() || after->t_s > out.back().t_s))
+    out.push_back(*after);
+  return out;
+}
+
 imu::Preintegrator ImuBuffer::preintegrate(double t_from_s, double t_to_s,
                                            const imu::ImuBias& bias_hat,
                                            const imu::ImuNoise& noise) const {
   imu::Preintegrator pre(bias_hat, noise);
-  if (samples_.empty() || t_to_s <= t_from_s) return pre;
-  double t = t_from_s;
-  for (std::size_t i = inForce(samples_, t_from_s); i < samples_.size() && t < t_to_s; ++i) {
-    const double t_next = i + 1 < samples_.size() ? std::min(samples_[i + 1].t_s, t_to_s) : t_to_s;
-    if (t_next > t) {
-      pre.integrate(samples_[i].acceleration_imu_mps2, samples_[i].angular_velocity_imu_radps,
-                    t_next - t);
-      t = t_next;
-    }
-  }
+  using Reading = Eigen::Matrix<double, 6, 1>;  // [acceleration; angular velocity]
+  imu::forEachPiece(
+      samples_, t_from_s, t_to_s,
+      [](const ImuSample& s) {
+        return (Reading() << s.acceleration_imu_mps2, s.angular_velocity_imu_radps).finished();
+      },
+      [&](double piece_from_s, double piece_to_s, const Reading& mean) {
+        pre.integrate(mean.head<3>(), mean.tail<3>(), piece_to_s - piece_from_s);
+      });
   return pre;
 }
 

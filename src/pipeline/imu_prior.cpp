@@ -82,7 +82,7 @@ MotionPrediction ImuPrior::predict(const io::Scan& scan) {
   const double t_from_s = std::min(previous.t_s, scan.t_start_s);
   const auto states =
       imu::propagateThrough(previous.state, previous.t_s, scan.t_end_s,
-                            imu_.between(t_from_s, scan.t_end_s), previous.bias, gravity_odom_);
+                            imu_.signalOver(t_from_s, scan.t_end_s), previous.bias, gravity_odom_);
   for (std::size_t k = 1; k < states.size(); ++k)
     prediction.imu_rate_poses.push_back({states[k].t_s, poseOf(states[k].state)});
   prediction.sweep_T_odom_body = imu::toTrajectory(states);

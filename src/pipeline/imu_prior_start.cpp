@@ -50,7 +50,7 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
   registration::NdtConfig ndt = registration_.ndt;
   ndt.search = registration::NeighbourSearch::kDirect7;
   for (int round = 0; round < 2; ++round) {
-    const std::vector<ImuSample> readings = imu_.between(t_init_s, second.t_end_s);
+    const std::vector<ImuSample> readings = imu_.signalOver(t_init_s, second.t_end_s);
     const auto over_first = imu::propagateThrough(at_first_start, t_init_s, first.t_end_s, readings,
                                                   init.bias, gravity_odom_);
     at_first_end = over_first.back().state;

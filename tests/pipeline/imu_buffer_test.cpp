@@ -18,7 +18,7 @@ ImuBuffer wavyBuffer(double t0, double t1, double rate_hz) {
   return buffer;
 }
 
-TEST(ImuBuffer, PreintegrationAndPropagationHoldTheSameReadings) {
+TEST(ImuBuffer, PreintegrationAndPropagationReadTheSameSignal) {
   // Between scan times that fall between readings, the preintegrated prediction and the
   // propagated state must be the same state: deskewing and the IMU factor see one motion.
   const ImuBuffer buffer = wavyBuffer(0.0, 2.0, 400.0);
@@ -28,7 +28,7 @@ TEST(ImuBuffer, PreintegrationAndPropagationHoldTheSameReadings) {
   const imu::NavState predicted =
       buffer.preintegrate(t0, t1, bias, imu::ImuNoise{}).predict(start, bias, kGravityWorld);
   const auto states =
-      imu::propagateThrough(start, t0, t1, buffer.between(t0, t1), bias, kGravityWorld);
+      imu::propagateThrough(start, t0, t1, buffer.signalOver(t0, t1), bias, kGravityWorld);
   EXPECT_LT((predicted.p_world - states.back().state.p_world).norm(), 1e-10);
   EXPECT_LT((predicted.v_world - states.back().state.v_world).norm(), 1e-10);
   EXPECT_LT((predicted.R_world_body.inverse() * states.back().state.R_world_body).angle(), 1e-10);
@@ -42,6 +42,7 @@ TEST(ImuBuffer, KeepsTheReadingInForceWhenDroppingAndIgnoresRepeatedTimes) {
   EXPECT_NEAR(buffer.firstTime(), 0.5, 1e-9);  // the reading held over 0.505
   const std::vector<ImuSample> readings = buffer.between(0.505, 0.535);
   ASSERT_EQ(readings.size(), 4u);  // 0.50, 0.51, 0.52, 0.53
+  EXPECT_EQ(buffer.signalOver(0.505, 0.535).size(), 5u);  // and 0.54, the one after the interval
   EXPECT_NEAR(readings.front().t_s, 0.5, 1e-9);
 }
 

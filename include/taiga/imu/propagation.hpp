@@ -3,7 +3,7 @@
 // poses inside a scan (deskewing, thesis Eq. 34-35) and IMU-rate poses between scans.
 //
 // Integration is the same first-order scheme as the preintegration ([Forster] Eq. 33 in the world
-// frame): each reading is held from its own time to the next reading's time.
+// frame), over the pieces between readings with each piece's mean reading (imu/readings.hpp).
 
 #include <span>
 #include <vector>
@@ -25,8 +25,8 @@ NavState propagate(const NavState& state, const Vector3& accel_body_mps2,
 
 /// The states at t_start_s, at every sample time inside (t_start_s, t_end_s), and at t_end_s,
 /// starting from `start` at t_start_s. `samples` must be sorted by time and should begin at or
-/// before t_start_s: the reading in force at a time is the latest sample at or before it (the
-/// first sample for times before all samples). Readings are corrected by `bias`. Throws
+/// before t_start_s; between them the readings are linear (imu/readings.hpp). Readings are
+/// corrected by `bias`. Throws
 /// std::invalid_argument when `samples` is empty or t_end_s < t_start_s.
 std::vector<StampedNavState> propagateThrough(const NavState& start, double t_start_s,
                                               double t_end_s, std::span<const ImuSample> samples,

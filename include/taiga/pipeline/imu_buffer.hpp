@@ -1,8 +1,8 @@
 #pragma once
 // IMU readings kept between scans: what preintegration, deskewing and IMU-rate poses read.
 //
-// A reading is held from its own time until the next reading's time (zero-order hold), the same
-// model as imu::propagateThrough, so preintegrated factors and propagated poses agree.
+// Between readings the signal is linear (imu/readings.hpp), the same model as
+// imu::propagateThrough, so preintegrated factors and propagated poses agree.
 
 #include <deque>
 #include <span>
@@ -22,9 +22,12 @@ class ImuBuffer {
   double lastTime() const { return samples_.back().t_s; }
   /// The readings from the one in force at t_from_s (the latest at or before it) up to t_to_s.
   std::vector<ImuSample> between(double t_from_s, double t_to_s) const;
+  /// The same and the first reading after t_to_s, when there is one: all that the signal over
+  /// the interval depends on (what propagation reads).
+  std::vector<ImuSample> signalOver(double t_from_s, double t_to_s) const;
   /// All readings, oldest first (for initialization).
   std::vector<ImuSample> all() const { return {samples_.begin(), samples_.end()}; }
-  /// Preintegrates the held readings over [t_from_s, t_to_s].
+  /// Preintegrates the readings over [t_from_s, t_to_s].
   imu::Preintegrator preintegrate(double t_from_s, double t_to_s, const imu::ImuBias& bias_hat,
                                   const imu::ImuNoise& noise) const;
   /// Forgets readings that no interval starting at or after t_s needs.
