@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plots for `taiga eval --plots DIR` and `taiga compare --plots DIR`.
+"""Plots for `taiga eval --plots DIR`, `taiga compare --plots DIR` and `taiga calibrate`.
 
 Usage: /usr/bin/python3 plot_eval.py DATA.json OUT_DIR LISTING
 
@@ -121,6 +121,24 @@ def plot_compare(data, out_dir, written):
     save(fig, out_dir, "compare_ape.png", written)
 
 
+def plot_calibration(data, out_dir, written):
+    """The profile cost of the lidar-IMU time offset (docs/calibration.md)."""
+    curve = data["cost_curve"]
+    offsets_ms = [1e3 * t for t in curve["offset_s"]]
+    rms_deg_s = [57.29577951308232 * r for r in curve["rms_radps"]]
+    estimate_ms = 1e3 * data["time_offset"]["estimated_s"]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(offsets_ms, rms_deg_s, color="tab:blue", linewidth=1.2)
+    ax.axvline(estimate_ms, color="tab:red", linestyle="--", linewidth=1.0,
+               label=f"estimate {estimate_ms:.2f} ms")
+    ax.set_xlabel("lidar time offset (s added to lidar times), ms")
+    ax.set_ylabel("gyro vs registration, RMS deg/s")
+    ax.set_title("Time offset: profile cost (rotation and gyro bias fitted at each offset)")
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    save(fig, out_dir, "offset_cost.png", written)
+
+
 def main(argv):
     if len(argv) != 4:
         sys.stderr.write(__doc__)
@@ -139,6 +157,8 @@ def main(argv):
         plot_eval(data, out_dir, written)
     elif kind == "compare":
         plot_compare(data, out_dir, written)
+    elif kind == "calibration":
+        plot_calibration(data, out_dir, written)
     else:
         sys.stderr.write(f"plot_eval.py: {data_path}: unknown kind {kind!r}\n")
         return 2

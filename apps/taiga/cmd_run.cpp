@@ -55,12 +55,27 @@ void printHealth(const pipeline::HealthReport& h) {
         h.median_innovation_deg, h.median_innovation_m,
         h.calibration_suspect
             ? ": too far apart, the extrinsic rotation, time offset or IMU noise settings "
-              "are suspect (docs/odometry.md, Health)"
+              "are suspect (docs/odometry.md, Health); taiga calibrate or calibration.at_start "
+              "estimates the first two (docs/calibration.md)"
             : "");
   if (h.trackLost())
     fmt::print(
         "           the track was lost and not re-attached: the trajectory and map after it are "
         "not tied to those before it (scans.csv marks every scan; exit code 3)\n");
+}
+
+void printCalibration(const pipeline::CalibrationRunReport& c) {
+  if (!c.skipped.empty()) {
+    fmt::print("calibrate  skipped, the configured rig is used: {}\n", c.skipped);
+    return;
+  }
+  fmt::print(
+      "calibrate  {} passes in {:.0f} s: lidar time offset {:.2f} ms ({:+.2f} ms, 1-sigma {:.2f} "
+      "ms{}), R_body_lidar changed by {:.3f} deg (observable about: {})\n",
+      c.passes, c.wall_time_s, 1e3 * c.time_offset_s, 1e3 * c.offset_change_s,
+      1e3 * c.offset_sigma_s, c.offset_observable ? "" : ", not observable: kept",
+      c.rotation_change_deg, c.rotation_observable_axes.empty() ? "none" : c.rotation_observable_axes);
+  if (!c.advice.empty()) fmt::print("           {}\n", c.advice);
 }
 
 int run(const RunOptions& options) {
@@ -74,6 +89,7 @@ int run(const RunOptions& options) {
                                                         .map_voxel_m = options.map_voxel_m,
                                                         .realtime = options.realtime,
                                                         .moving_boxes_file = options.moving_boxes});
+  if (s.calibration) printCalibration(*s.calibration);
   fmt::print("scans      {} read, {} processed; {} IMU samples; {:.1f} s, {:.1f} m of path\n",
              s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
   fmt::print("lidar      lidar factors {} rejected, {} inflated; {} keyframes, {} map points\n",

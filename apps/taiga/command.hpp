@@ -42,5 +42,6 @@ Command addCompareCommand(CLI::App& tool);
 Command addGeorefCommand(CLI::App& tool);
 Command addConfigCommand(CLI::App& tool);
 Command addExportMapCommand(CLI::App& tool);
+Command addCalibrateCommand(CLI::App& tool);
 
 }  // namespace taiga::app

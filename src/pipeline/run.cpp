@@ -20,6 +20,8 @@
 #include "taiga/io/moving_boxes.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/mapping/map_export.hpp"
+#include "taiga/core/angles.hpp"
+#include "taiga/pipeline/self_calibration.hpp"
 #include "taiga/pipeline/slam_system.hpp"
 
 namespace taiga::pipeline {
@@ -119,12 +121,43 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
   return scans;
 }
 
+/// calibration.at_start: the rig's time offset and rotation from the recording's first stretch
+/// (self_calibration.hpp), written into `config`; a recording that cannot be calibrated keeps
+/// the configured rig and the report says why.
+CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording, SystemConfig& config) {
+  CalibrationRunReport report;
+  const auto start = Clock::now();
+  try {
+    const SelfCalibration c = selfCalibrate(recording, config);
+    config.rig = c.rig;
+    report.passes = c.passes.size();
+    report.time_offset_s = c.rig.lidar_time_offset_s;
+    report.offset_change_s = c.offset_change_s;
+    report.offset_sigma_s = c.last.offset_sigma_s;
+    report.offset_observable = c.last.offset_observable;
+    report.rotation_change_deg = c.R_change.angle() * kDegPerRad;
+    report.rotation_sigma_deg = c.last.rotation_sigma_rad * kDegPerRad;
+    for (int axis = 0; axis < 3; ++axis)
+      if (c.last.rotation_observable(axis)) report.rotation_observable_axes += "xyz"[axis];
+    report.advice = c.last.advice;
+  } catch (const InputError& e) {
+    report.skipped = e.what();
+    logger().warn("calibration at the start skipped, the configured rig is used: {}", e.what());
+  }
+  report.wall_time_s = secondsSince(start);
+  return report;
+}
+
 }  // namespace
 
-RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& config,
-                       const RunOptions& options) {
+RunSummary runOdometry(const std::filesystem::path& recording_path,
+                       const SystemConfig& configured, const RunOptions& options) {
   const std::filesystem::path& out = options.out_dir;
   createOutputDirectory(out);
+  SystemConfig config = configured;
+  std::optional<CalibrationRunReport> calibration;
+  if (config.calibration.at_start && config.odometry.imu_use != "lidar_only")
+    calibration = calibrateAtStart(recording_path, config);
   io::Recording recording = io::openRecording(recording_path, config.recording, config.rig);
   std::deque<io::RecordingEvent> read_ahead;
   SlamSystem slam(config,
@@ -181,6 +214,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       summary.wall_time_s > 0.0 ? summary.duration_s / summary.wall_time_s : 0.0;
   summary.peak_memory_mb = peakMemoryMb();
   summary.initialization = slam.odometry().initializationNote();
+  summary.calibration = calibration;
   writeSummary(out / "summary.json", summary, recording_path, mapper.gnssReport());
   return summary;
 }

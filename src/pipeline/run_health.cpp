@@ -62,7 +62,8 @@ HealthReport HealthLog::finish() {
           "the IMU's prediction and the registration disagree by {:.2f} deg per scan (median; "
           "above odometry.health.max_median_innovation_deg {:.2f}): the lidar-IMU extrinsic "
           "rotation (rig.T_body_lidar), the time offset (rig.lidar_time_offset_s) or the IMU "
-          "noise settings are probably wrong, and the trajectory drifts for it",
+          "noise settings are probably wrong, and the trajectory drifts for it; `taiga calibrate` "
+          "or calibration.at_start: true estimates the first two (docs/calibration.md)",
           report_.median_innovation_deg, config_.max_median_innovation_deg);
   }
   return report_;

@@ -63,6 +63,21 @@ nlohmann::ordered_json healthJson(const HealthReport& h) {
           {"degraded", degraded}};
 }
 
+nlohmann::ordered_json calibrationJson(const CalibrationRunReport& c) {
+  if (!c.skipped.empty()) return {{"skipped", c.skipped}, {"wall_time_s", c.wall_time_s}};
+  const Eigen::Vector3d& sigma = c.rotation_sigma_deg;
+  return {{"passes", c.passes},
+          {"wall_time_s", c.wall_time_s},
+          {"lidar_time_offset_s", c.time_offset_s},
+          {"offset_change_s", c.offset_change_s},
+          {"offset_sigma_s", c.offset_sigma_s},
+          {"offset_observable", c.offset_observable},
+          {"rotation_change_deg", c.rotation_change_deg},
+          {"rotation_sigma_deg", {sigma.x(), sigma.y(), sigma.z()}},
+          {"rotation_observable_axes", c.rotation_observable_axes},
+          {"advice", c.advice}};
+}
+
 }  // namespace
 
 void writeSummary(const std::filesystem::path& path, const RunSummary& s,
@@ -122,6 +137,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
     j["georef"] = georef;
   }
   if (gnss_fusion) j["gnss_fusion"] = gnssFusionJson(*gnss_fusion);
+  if (s.calibration) j["calibration"] = calibrationJson(*s.calibration);
   openOutput(path) << j.dump(2) << "\n";
 }
 

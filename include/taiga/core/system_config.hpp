@@ -3,6 +3,7 @@
 // modules that own them land.
 
 #include "taiga/core/config.hpp"
+#include "taiga/core/calibration_config.hpp"
 #include "taiga/core/georef_config.hpp"
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
@@ -17,6 +18,7 @@ struct SystemConfig final : ConfigSection {
   OdometryConfig odometry;
   MappingConfig mapping;
   GeorefConfig georef;
+  CalibrationConfig calibration;
 
   void visit(ConfigVisitor& v) override {
     v.section("rig", rig, "sensor rig: extrinsics, clock offset and units");
@@ -25,6 +27,8 @@ struct SystemConfig final : ConfigSection {
               "lidar-inertial odometry: preprocessing, registration, keyframes, IMU noise");
     v.section("mapping", mapping, "keyframe graph and loop closures");
     v.section("georef", georef, "georeferencing with GNSS: post-fit method, output CRS, gating");
+    v.section("calibration", calibration,
+              "self-calibration of the lidar-IMU time offset and extrinsic rotation");
   }
 };
 

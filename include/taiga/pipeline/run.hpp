@@ -97,6 +97,21 @@ struct HealthReport {
   std::string verdict() const;
 };
 
+/// The self-calibration before the run (calibration.at_start, docs/calibration.md).
+struct CalibrationRunReport {
+  std::string skipped;  ///< why the run kept the configured rig; empty when it calibrated
+  double wall_time_s = 0.0;
+  std::size_t passes = 0;
+  double time_offset_s = 0.0;    ///< rig.lidar_time_offset_s the run used
+  double offset_change_s = 0.0;  ///< from the configured one
+  double offset_sigma_s = 0.0;
+  bool offset_observable = false;
+  double rotation_change_deg = 0.0;  ///< of R_body_lidar, from the configured one
+  Eigen::Vector3d rotation_sigma_deg = Eigen::Vector3d::Zero();  ///< about body x, y, z
+  std::string rotation_observable_axes;  ///< e.g. "xyz", "xy", "" (none)
+  std::string advice;                    ///< what motion would calibrate what was not observable
+};
+
 struct RunSummary {
   std::size_t scans = 0;            ///< scans read
   std::size_t scans_processed = 0;  ///< scans that gave a state
@@ -121,6 +136,7 @@ struct RunSummary {
   HealthReport health;
   std::optional<RealtimeReport> realtime;  ///< with --realtime only
   std::optional<GeorefRunReport> georef;   ///< when the recording has GNSS fixes
+  std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
 };
 
 /// Runs the odometry over `recording` and writes the outputs into options.out_dir (created).

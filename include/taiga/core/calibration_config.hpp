@@ -1,0 +1,24 @@
+#pragma once
+// Self-calibration of the rig (docs/calibration.md): the lidar-IMU time offset and extrinsic
+// rotation estimated from the data, by `taiga calibrate` and at the start of `taiga run`.
+
+#include "taiga/core/config.hpp"
+
+namespace taiga {
+
+struct CalibrationConfig final : ConfigSection {
+  /// `taiga run` first calibrates on the recording's first stretch_s and runs with the result.
+  bool at_start = false;
+  /// Length of the stretch calibrated on, s.
+  double stretch_s = 30.0;
+  /// A quantity whose 1-sigma exceeds these is not observable from the motion and stays as
+  /// configured.
+  double max_offset_sigma_s = 0.002;
+  double max_rotation_sigma_deg = 0.1;
+  double max_translation_sigma_m = 0.01;
+
+  void visit(ConfigVisitor& v) override;
+  void validate() const override;
+};
+
+}  // namespace taiga

@@ -1,0 +1,54 @@
+#pragma once
+// The rig's lidar-IMU time offset and extrinsic rotation from a stretch of a recording
+// (docs/calibration.md): the lidar-inertial odometry runs over the stretch, its scan-to-map
+// registrations give the body's rotation between scans, and calib::estimateTimeRotation compares
+// them with the gyro. The registrations lean a little on the IMU (its prediction starts them,
+// its propagation deskews the scan), so a wrong rig pulls them a little towards itself: each pass
+// runs again with the rig the previous one found, until a pass changes nothing beyond its own
+// 1-sigma (a wrong offset shrinks about fourfold per pass).
+// A lidar-only first pass was tried and dropped: at 10 Hz its constant-velocity deskew leaves
+// errors of degrees per scan in a handheld's sway, as large as the signal.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "taiga/calib/lever_arm.hpp"
+#include "taiga/calib/time_rotation.hpp"
+#include "taiga/core/system_config.hpp"
+
+namespace taiga::pipeline {
+
+struct SelfCalibrationOptions {
+  double from_s = 0.0;      ///< start of the stretch, s after the recording's first scan
+  double duration_s = 0.0;  ///< length of the stretch, s; 0: calibration.stretch_s
+  int max_passes = 5;
+};
+
+struct CalibrationPass {
+  std::size_t scans = 0;
+  calib::TimeRotationEstimate estimate;  ///< relative to the pass's rig
+  std::string failed;                    ///< why the pass gave no estimate; empty when it did
+};
+
+struct SelfCalibration {
+  RigConfig rig;                  ///< the configured rig with the offset and rotation corrected
+  double offset_change_s = 0.0;   ///< rig.lidar_time_offset_s minus the configured one
+  lie::SO3 R_change;              ///< R_body_lidar = R_change * R_body_lidar_configured
+  calib::TimeRotationEstimate last;  ///< the last pass's estimate: its sigmas and observability
+  /// The lever arm from the last pass, reported and not applied to `rig` (self_calibration.cpp);
+  /// empty when it could not be estimated (lever_arm_failed says why).
+  std::optional<calib::LeverArmEstimate> lever_arm;
+  std::string lever_arm_failed;
+  std::vector<CalibrationPass> passes;
+  double from_s = 0.0, to_s = 0.0;  ///< the stretch used, recording time
+};
+
+/// The estimate with config.calibration's observability limits. Throws InputError when the
+/// first pass gives no estimate (the message says why, e.g. no IMU,
+/// too short a recording, or too few registrations that agree with the gyro).
+SelfCalibration selfCalibrate(const std::filesystem::path& recording, const SystemConfig& config,
+                              const SelfCalibrationOptions& options = {});
+
+}  // namespace taiga::pipeline

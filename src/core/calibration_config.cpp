@@ -1,0 +1,25 @@
+#include "taiga/core/calibration_config.hpp"
+
+namespace taiga {
+
+void CalibrationConfig::visit(ConfigVisitor& v) {
+  v.field("at_start", at_start,
+          "true: taiga run first estimates rig.lidar_time_offset_s and the rotation of "
+          "rig.T_body_lidar on the recording's first stretch_s, then runs with them");
+  v.field("stretch_s", stretch_s, "s of the recording calibrated on");
+  v.field("max_offset_sigma_s", max_offset_sigma_s,
+          "s; a time offset less certain than this is not observable and stays as configured");
+  v.field("max_rotation_sigma_deg", max_rotation_sigma_deg,
+          "deg; a rotation less certain than this about an axis stays as configured");
+  v.field("max_translation_sigma_m", max_translation_sigma_m,
+          "m; a lever arm less certain than this along a direction stays as configured");
+}
+
+void CalibrationConfig::validate() const {
+  requireInRange("stretch_s", stretch_s, 5.0, 3600.0, "s");
+  requireInRange("max_offset_sigma_s", max_offset_sigma_s, 1e-5, 0.1, "s");
+  requireInRange("max_rotation_sigma_deg", max_rotation_sigma_deg, 0.001, 10.0, "deg");
+  requireInRange("max_translation_sigma_m", max_translation_sigma_m, 0.0001, 1.0, "m");
+}
+
+}  // namespace taiga
