@@ -10,9 +10,10 @@
 // rig.lidar_time_offset_s. The rotation-vector residual
 //   r_k = Log(ΔR_gyro,k(dt, b)) - R_c Log(ΔR_reg,k)                                    (1)
 // is minimized over (R_c, b) in closed form for each dt on a grid (a profile cost, its curve is
-// the report's plot), then over (dt, R_c, b) together by Gauss-Newton. Covariances use a
-// lag-2 Newey-West estimate, because consecutive increments share a registration and their
-// errors are correlated.
+// the report's plot), then over (dt, R_c, b) together by Gauss-Newton. The reported variances
+// are the largest of three: the fit's own, a lag-2 Newey-West estimate (consecutive increments
+// share a registration, so their errors are correlated), and a jackknife over six blocks of the
+// stretch (errors correlated over seconds, a drifting clock).
 
 #include <Eigen/Core>
 #include <string>
@@ -38,7 +39,8 @@ struct GyroReading {
 struct TimeRotationOptions {
   double max_offset_s = 0.2;   ///< the grid spans +-max_offset_s around the configured offset
   double grid_step_s = 0.001;  ///< grid spacing of the profile cost
-  /// A quantity whose 1-sigma exceeds these is not observable from the motion: held at its
+  /// A quantity whose 1-sigma exceeds these is not observable from the motion, unless its change
+  /// is significant (at least 3 sigma) and its 1-sigma within ten times these: held at its
   /// configured value (rotation: per direction of the information's eigenvectors).
   double max_offset_sigma_s = 0.002;
   double max_rotation_sigma_rad = 0.002;  // 0.11 deg

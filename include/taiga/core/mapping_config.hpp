@@ -24,7 +24,9 @@ struct MappingConfig final : ConfigSection {
   double loop_max_rotation_deg = 10.0;  ///< largest correction a loop may imply, besides the radius
   /// Consistency with the graph: a loop is kept when adding it raises the graph's optimal cost
   /// by at most this chi^2 (twice the cost change; the innovation's squared Mahalanobis distance).
-  double loop_max_chi2 = 50.0;
+  /// 25 is chi^2(6 dof) at 99.97 %; true loops measured up to 4.6 (bench/BENCHMARK.md), a false
+  /// loop 1.5 m / 3 deg off after 200 m without an earlier loop at 46.8 (session 20).
+  double loop_max_chi2 = 25.0;
   // Odometry between consecutive keyframes: sigma = floor + per-metre growth * distance.
   double odometry_sigma_m = 0.002;
   double odometry_sigma_m_per_m = 0.003;
