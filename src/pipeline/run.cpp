@@ -140,7 +140,7 @@ CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording, Sy
     for (int axis = 0; axis < 3; ++axis)
       if (c.last.rotation_observable(axis)) report.rotation_observable_axes += "xyz"[axis];
     report.advice = c.last.advice;
-  } catch (const InputError& e) {
+  } catch (const std::exception& e) {  // bad input or a pass that failed: the run goes on
     report.skipped = e.what();
     logger().warn("calibration at the start skipped, the configured rig is used: {}", e.what());
   }

@@ -76,6 +76,12 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
   config.odometry.imu.accel_bias_random_walk = imu.accel_bias_random_walk * walk_factor;
   config.odometry.imu.gyro_bias_random_walk = imu.gyro_bias_random_walk * walk_factor;
   config.odometry.imu.gravity_mps2 = imu.gravity_mps2;
+  // A rig stated exactly needs no calibration at the start of a run (docs/calibration.md).
+  const bool stated_exactly = rig_error.extrinsic_rotation_error_deg == 0.0 &&
+                              rig_error.extrinsic_translation_error_m == 0.0 &&
+                              rig_error.lidar_time_offset_s == 0.0 &&
+                              rig_error.lidar_clock_drift_ppm == 0.0;
+  config.calibration.at_start = !(truth || stated_exactly);
   if (simulation.lidar().rows() >= 64) {
     // Dense scans: the settings of config/os0-128-handheld.yaml (docs/odometry.md, "Scale").
     config.odometry.ndt_resolution_m = 0.5;

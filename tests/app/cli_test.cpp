@@ -31,7 +31,7 @@ TEST(Cli, PrintsItsVersion) {
 TEST(Cli, EverySubcommandHasHelp) {
   for (const char* name :
        {"simulate", "info", "export", "register", "run", "eval", "compare", "georef", "config",
-        "export-map"}) {
+        "export-map", "calibrate"}) {
     const Result r = runTaiga(std::string(name) + " --help");
     EXPECT_EQ(r.exit_code, 0) << name;
     EXPECT_THAT(r.output, HasSubstr(std::string("Usage: ") + TAIGA_EXECUTABLE + " " + name))

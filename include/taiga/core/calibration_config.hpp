@@ -8,7 +8,9 @@ namespace taiga {
 
 struct CalibrationConfig final : ConfigSection {
   /// `taiga run` first calibrates on the recording's first stretch_s and runs with the result.
-  bool at_start = false;
+  /// On by default: a rig as users write it is off by degrees and milliseconds; a calibrated
+  /// rig can switch it off.
+  bool at_start = true;
   /// Length of the stretch calibrated on, s.
   double stretch_s = 30.0;
   /// A quantity whose 1-sigma exceeds these is not observable from the motion and stays as
