@@ -34,13 +34,15 @@ std::vector<double> xyzw(const lie::SO3& R) {
 
 /// The lever arm is estimated and reported, not applied (docs/calibration.md, "Lever arm").
 nlohmann::json leverArmJson(const pipeline::SelfCalibration& c) {
-  if (!c.lever_arm) return {{"estimated", false}, {"applied", false}, {"failed", c.lever_arm_failed}};
+  if (!c.lever_arm)
+    return {{"estimated", false}, {"applied", false}, {"failed", c.lever_arm_failed}};
   const calib::LeverArmEstimate& e = *c.lever_arm;
   return {{"estimated", true},
           {"applied", false},
           {"change_m", asVector(e.correction_m)},
           {"sigma_m", asVector(e.sigma_m)},
-          {"observable_along_body_xyz", std::vector<bool>{e.observable(0), e.observable(1), e.observable(2)}},
+          {"observable_along_body_xyz",
+           std::vector<bool>{e.observable(0), e.observable(1), e.observable(2)}},
           {"note",
            "not applied to rig.yaml: on registered poses the estimate is biased by 1.5-2.3 cm "
            "along the vertical even for a perfectly calibrated rig (docs/calibration.md)"}};
@@ -59,13 +61,12 @@ nlohmann::json report(const std::string& recording, const SystemConfig& configur
                       {"observable", e.offset_observable}};
   std::vector<bool> observable{e.rotation_observable(0), e.rotation_observable(1),
                                e.rotation_observable(2)};
-  j["rotation"] = {
-      {"configured_quaternion_xyzw", xyzw(configured.rig.T_body_lidar.rotation())},
-      {"estimated_quaternion_xyzw", xyzw(c.rig.T_body_lidar.rotation())},
-      {"change_deg", c.R_change.angle() * kDegPerRad},
-      {"change_rotation_vector_deg", asVector(degrees(c.R_change.Log()))},
-      {"sigma_deg", asVector(degrees(e.rotation_sigma_rad))},
-      {"observable_about_body_xyz", observable}};
+  j["rotation"] = {{"configured_quaternion_xyzw", xyzw(configured.rig.T_body_lidar.rotation())},
+                   {"estimated_quaternion_xyzw", xyzw(c.rig.T_body_lidar.rotation())},
+                   {"change_deg", c.R_change.angle() * kDegPerRad},
+                   {"change_rotation_vector_deg", asVector(degrees(c.R_change.Log()))},
+                   {"sigma_deg", asVector(degrees(e.rotation_sigma_rad))},
+                   {"observable_about_body_xyz", observable}};
   j["translation"] = leverArmJson(c);
   j["gyro_bias_radps"] = asVector(e.gyro_bias_radps);
   j["residual_rms_deg_s"] = e.residual_rms_radps * kDegPerRad;
@@ -125,12 +126,14 @@ int run(const CalibrateOptions& options) {
   const calib::TimeRotationEstimate& e = c.last;
   fmt::print("stretch    {:.0f}-{:.0f} s, {} passes, {} scan-to-scan rotations used ({} dropped)\n",
              c.from_s, c.to_s, c.passes.size(), e.increments_used, e.increments_dropped);
-  fmt::print("offset     rig.lidar_time_offset_s {:.4f} s (change {:+.2f} ms, 1-sigma {:.2f} ms){}\n",
-             c.rig.lidar_time_offset_s, 1e3 * c.offset_change_s, 1e3 * e.offset_sigma_s,
-             e.offset_observable ? "" : ": not observable, kept as configured");
+  fmt::print(
+      "offset     rig.lidar_time_offset_s {:.4f} s (change {:+.2f} ms, 1-sigma {:.2f} ms){}\n",
+      c.rig.lidar_time_offset_s, 1e3 * c.offset_change_s, 1e3 * e.offset_sigma_s,
+      e.offset_observable ? "" : ": not observable, kept as configured");
   const Eigen::Vector3d sigma_deg = degrees(e.rotation_sigma_rad);
   fmt::print(
-      "rotation   R_body_lidar changed by {:.3f} deg (1-sigma {:.3f} {:.3f} {:.3f} deg about body x y "
+      "rotation   R_body_lidar changed by {:.3f} deg (1-sigma {:.3f} {:.3f} {:.3f} deg about body "
+      "x y "
       "z; observable about: {})\n",
       c.R_change.angle() * kDegPerRad, sigma_deg.x(), sigma_deg.y(), sigma_deg.z(),
       axes(e.rotation_observable));
@@ -151,8 +154,9 @@ int run(const CalibrateOptions& options) {
     const eval::PlotOutcome plots = eval::makePlots(j.dump(), out, "calibration_plot_data.json");
     if (!plots.ok) fmt::print("plots      not drawn: {}\n", plots.message);
   }
-  fmt::print("outputs    {}/ (rig.yaml: the configuration with the corrected rig, calibration.json{})\n",
-             options.out, options.plots ? ", offset_cost.png" : "");
+  fmt::print(
+      "outputs    {}/ (rig.yaml: the configuration with the corrected rig, calibration.json{})\n",
+      options.out, options.plots ? ", offset_cost.png" : "");
   const bool nothing = !e.offset_observable && !e.rotation_observable.any();
   return nothing ? kExitFailure : kExitOk;
 }

@@ -32,15 +32,10 @@ std::vector<Step> steps(const LeverArmInput& in, Eigen::Index* unknowns) {
   for (const std::vector<StampedPose>& chain : in.chains) {
     for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
       imu::Preintegrator pre(in.bias_hat, in.noise);
-      using Reading = Eigen::Matrix<double, 6, 1>;
-      imu::forEachPiece(
-          in.imu_body, chain[k].t_s, chain[k + 1].t_s,
-          [](const ImuSample& s) {
-            return (Reading() << s.acceleration_imu_mps2, s.angular_velocity_imu_radps).finished();
-          },
-          [&](double t0_s, double t1_s, const Reading& mean) {
-            pre.integrate(mean.head<3>(), mean.tail<3>(), t1_s - t0_s);
-          });
+      imu::forEachPiece(in.imu_body, chain[k].t_s, chain[k + 1].t_s, imu::accelGyro,
+                        [&](double t0_s, double t1_s, const imu::AccelGyro& mean) {
+                          pre.integrate(mean.head<3>(), mean.tail<3>(), t1_s - t0_s);
+                        });
       out.push_back({&chain[k], &chain[k + 1], column + 3 * static_cast<Eigen::Index>(k),
                      column + 3 * static_cast<Eigen::Index>(k + 1), pre});
     }

@@ -105,8 +105,8 @@ State alignAtOffset(const Problem& p, double offset_s, double* rms_radps) {
   }
   double sum_r2 = 0.0, sum_dt2 = 0.0;
   for (std::size_t k = 0; k < p.size(); ++k) {
-    sum_r2 += (g[k] - s.bias_radps * p.duration(k) - s.R_c * p.increment(k).theta_body_rad)
-                  .squaredNorm();
+    sum_r2 +=
+        (g[k] - s.bias_radps * p.duration(k) - s.R_c * p.increment(k).theta_body_rad).squaredNorm();
     sum_dt2 += p.duration(k) * p.duration(k);
   }
   *rms_radps = std::sqrt(sum_r2 / sum_dt2);
@@ -114,7 +114,8 @@ State alignAtOffset(const Problem& p, double offset_s, double* rms_radps) {
 }
 
 /// The profile cost over the offset grid; returns the state at its minimum.
-State profileMinimum(const Problem& p, const TimeRotationOptions& o, std::vector<CostPoint>* curve) {
+State profileMinimum(const Problem& p, const TimeRotationOptions& o,
+                     std::vector<CostPoint>* curve) {
   curve->clear();
   State best;
   double best_rms = std::numeric_limits<double>::infinity();
@@ -203,8 +204,8 @@ ParamMatrix jackknife(const Problem& p, const State& s, const Basis& basis) {
     std::vector<bool> keep(p.size());
     std::size_t kept = 0;
     for (std::size_t k = 0; k < p.size(); ++k) {
-      const int b = std::min(
-          kBlocks - 1, static_cast<int>(kBlocks * (p.increment(k).t0_s - t0) / (t1 - t0)));
+      const int b =
+          std::min(kBlocks - 1, static_cast<int>(kBlocks * (p.increment(k).t0_s - t0) / (t1 - t0)));
       keep[k] = b != block;
       kept += keep[k];
     }
@@ -265,7 +266,8 @@ double gyroReadingVariance(const std::vector<GyroReading>& gyro) {
   return n > 0 ? sum / (6.0 * 3.0 * static_cast<double>(n)) : 0.0;
 }
 
-Excitation measureExcitation(const Problem& p, const State& s, const std::vector<GyroReading>& gyro) {
+Excitation measureExcitation(const Problem& p, const State& s,
+                             const std::vector<GyroReading>& gyro) {
   const double n = static_cast<double>(p.size());
   double sum_r2 = 0.0, offset_information = 0.0;
   Matrix3d rotation_information = Matrix3d::Zero();
@@ -287,8 +289,8 @@ Excitation measureExcitation(const Problem& p, const State& s, const std::vector
                               before.theta_body_rad / (before.t1_s - before.t0_s);
       // d r / d offset ~ change / 2; each increment's noise is about residual_variance per
       // component, so the change's noise adds 3 * 2 * residual_variance / dt^2 / 4.
-      lidar_information += 0.25 * change.squaredNorm() -
-                           1.5 * residual_variance / square(p.duration(k));
+      lidar_information +=
+          0.25 * change.squaredNorm() - 1.5 * residual_variance / square(p.duration(k));
     }
   offset_information = std::min(offset_information, lidar_information);
   rotation_information -= n * 2.0 * residual_variance * Matrix3d::Identity();
@@ -340,8 +342,8 @@ std::string advice(const TimeRotationEstimate& e) {
   std::string text = "the motion was too poor to calibrate";
   if (!e.offset_observable) text += " the time offset (it needs turns that speed up and slow down)";
   if (!unexcited.empty())
-    text += fmt::format("{} the rotation about the body's {} axis", e.offset_observable ? "" : " and",
-                        unexcited);
+    text += fmt::format("{} the rotation about the body's {} axis",
+                        e.offset_observable ? "" : " and", unexcited);
   return text +
          ": rotate the rig about all three axes, back and forth, for 10 s (a handheld scanner: "
          "tilt it left-right and forward-back while turning) and calibrate on that stretch";
@@ -385,8 +387,9 @@ TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& 
   State s = profileMinimum(problem, options, &e.cost_curve);
   problem.keep(inliers(problem, s, options.outlier_sigmas));
   if (problem.size() < kMinIncrements)
-    throw InputError(fmt::format("calibration: only {} of {} scan-to-scan rotations agree with the gyro",
-                                 problem.size(), all));
+    throw InputError(
+        fmt::format("calibration: only {} of {} scan-to-scan rotations agree with the gyro",
+                    problem.size(), all));
   e.increments_used = problem.size();
   e.increments_dropped = all - problem.size();
   if (e.increments_dropped > 0) s = profileMinimum(problem, options, &e.cost_curve);

@@ -24,13 +24,9 @@ std::vector<StampedNavState> propagateThrough(const NavState& start, double t_st
   if (t_end_s < t_start_s)
     throw std::invalid_argument("propagateThrough: t_end_s before t_start_s");
   std::vector<StampedNavState> states{{t_start_s, start}};
-  using Reading = Eigen::Matrix<double, 6, 1>;  // [acceleration; angular velocity]
   forEachPiece(
-      samples, t_start_s, t_end_s,
-      [](const ImuSample& s) {
-        return (Reading() << s.acceleration_imu_mps2, s.angular_velocity_imu_radps).finished();
-      },
-      [&](double t_from_s, double t_to_s, const Reading& mean) {
+      samples, t_start_s, t_end_s, accelGyro,
+      [&](double t_from_s, double t_to_s, const AccelGyro& mean) {
         states.push_back({t_to_s, propagate(states.back().state, mean.head<3>() - bias.accel_mps2,
                                             mean.tail<3>() - bias.gyro_radps, t_to_s - t_from_s,
                                             gravity_world)});

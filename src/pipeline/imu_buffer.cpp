@@ -46,15 +46,10 @@ imu::Preintegrator ImuBuffer::preintegrate(double t_from_s, double t_to_s,
                                            const imu::ImuBias& bias_hat,
                                            const imu::ImuNoise& noise) const {
   imu::Preintegrator pre(bias_hat, noise);
-  using Reading = Eigen::Matrix<double, 6, 1>;  // [acceleration; angular velocity]
-  imu::forEachPiece(
-      samples_, t_from_s, t_to_s,
-      [](const ImuSample& s) {
-        return (Reading() << s.acceleration_imu_mps2, s.angular_velocity_imu_radps).finished();
-      },
-      [&](double piece_from_s, double piece_to_s, const Reading& mean) {
-        pre.integrate(mean.head<3>(), mean.tail<3>(), piece_to_s - piece_from_s);
-      });
+  imu::forEachPiece(samples_, t_from_s, t_to_s, imu::accelGyro,
+                    [&](double piece_from_s, double piece_to_s, const imu::AccelGyro& mean) {
+                      pre.integrate(mean.head<3>(), mean.tail<3>(), piece_to_s - piece_from_s);
+                    });
   return pre;
 }
 

@@ -37,31 +37,36 @@ PassData runPass(const std::filesystem::path& path, const SystemConfig& config,
   const Eigen::Matrix3d R_body_imu = rig.T_body_imu.rotation().matrix();
   PassData data;
   std::optional<double> first_scan_s;
-  std::optional<ScanOutcome> previous;
+  struct Previous {  // what the next scan needs of the one before it
+    std::uint64_t scan_index = 0;
+    double t_s = 0.0;
+    bool measured = false;
+    lie::SO3 R_odom_body;
+  };
+  std::optional<Previous> previous;
   std::vector<std::vector<StampedPose>>& chains = data.lever_arm.chains;
   auto take = [&](const ScanOutcome& o) {
-    const bool follows = previous && measured(*previous) && measured(o) &&
+    const lie::SE3& T_odom_body = o.registration.T_target_source;
+    const bool follows = previous && previous->measured && measured(o) &&
                          o.scan_index == previous->scan_index + 1 && !o.T_odom_unlevelled;
     if (follows)
       data.increments.push_back(
-          {previous->t_s, o.t_s,
-           (previous->registration.T_target_source.rotation().inverse() *
-            o.registration.T_target_source.rotation())
-               .Log()});
+          {previous->t_s, o.t_s, (previous->R_odom_body.inverse() * T_odom_body.rotation()).Log()});
     // Poses for the lever arm: only in the levelled frame, the levelling scan not included.
     if (o.T_odom_unlevelled) chains.clear();
     if (measured(o) && !o.T_odom_unlevelled) {
       if (!follows || chains.empty()) chains.emplace_back();
-      chains.back().push_back({o.t_s, o.registration.T_target_source});
+      chains.back().push_back({o.t_s, T_odom_body});
     }
-    previous = o;
+    previous = Previous{o.scan_index, o.t_s, measured(o), T_odom_body.rotation()};
   };
   while (std::optional<io::RecordingEvent> event = recording.next()) {
     if (const auto* imu = std::get_if<ImuSample>(&*event)) {
       data.gyro.push_back({imu->t_s, R_body_imu * imu->angular_velocity_imu_radps});
-      data.lever_arm.imu_body.push_back({.t_s = imu->t_s,
-                                         .acceleration_imu_mps2 = R_body_imu * imu->acceleration_imu_mps2,
-                                         .angular_velocity_imu_radps = data.gyro.back().omega_body_radps});
+      data.lever_arm.imu_body.push_back(
+          {.t_s = imu->t_s,
+           .acceleration_imu_mps2 = R_body_imu * imu->acceleration_imu_mps2,
+           .angular_velocity_imu_radps = data.gyro.back().omega_body_radps});
       odometry.addImu(*imu);
       if (first_scan_s && imu->t_s > *first_scan_s + to_s + margin_s) break;
     } else if (const auto* scan = std::get_if<io::Scan>(&*event)) {
@@ -80,8 +85,8 @@ PassData runPass(const std::filesystem::path& path, const SystemConfig& config,
 /// The rig with a pass's estimate applied.
 RigConfig corrected(RigConfig rig, const calib::TimeRotationEstimate& e) {
   rig.lidar_time_offset_s += e.offset_s;
-  rig.T_body_lidar = lie::SE3(e.R_correction * rig.T_body_lidar.rotation(),
-                              rig.T_body_lidar.translation());
+  rig.T_body_lidar =
+      lie::SE3(e.R_correction * rig.T_body_lidar.rotation(), rig.T_body_lidar.translation());
   return rig;
 }
 
@@ -108,9 +113,11 @@ void estimateLeverArm(PassData& data, double max_sigma_m, SelfCalibration& resul
   data.lever_arm.bias_hat.gyro_radps = result.last.gyro_bias_radps;
   try {
     const calib::LeverArmEstimate e = calib::estimateLeverArm(data.lever_arm, max_sigma_m);
-    logger().info("calibration: lever arm would change by {:.1f} {:.1f} {:.1f} cm (1-sigma {:.1f} {:.1f} {:.1f} cm; not applied)",
-                  100 * e.correction_m.x(), 100 * e.correction_m.y(), 100 * e.correction_m.z(),
-                  100 * e.sigma_m.x(), 100 * e.sigma_m.y(), 100 * e.sigma_m.z());
+    logger().info(
+        "calibration: lever arm would change by {:.1f} {:.1f} {:.1f} cm (1-sigma {:.1f} {:.1f} "
+        "{:.1f} cm; not applied)",
+        100 * e.correction_m.x(), 100 * e.correction_m.y(), 100 * e.correction_m.z(),
+        100 * e.sigma_m.x(), 100 * e.sigma_m.y(), 100 * e.sigma_m.z());
     result.lever_arm = e;
   } catch (const InputError& e) {
     result.lever_arm_failed = e.what();
@@ -145,7 +152,8 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
         throw InputError(fmt::format("{}: calibration failed: {}", recording.string(), e.what()));
       p.failed = e.what();
     }
-    logger().info("calibration pass {}: {}", pass + 1, p.failed.empty() ? describe(p.estimate) : p.failed);
+    logger().info("calibration pass {}: {}", pass + 1,
+                  p.failed.empty() ? describe(p.estimate) : p.failed);
     result.passes.push_back(p);
     if (!p.failed.empty()) break;  // keep the previous pass's rig
     result.rig = corrected(result.rig, p.estimate);
@@ -154,7 +162,8 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
   }
   estimateLeverArm(last_data, config.calibration.max_translation_sigma_m, result);
   result.offset_change_s = result.rig.lidar_time_offset_s - config.rig.lidar_time_offset_s;
-  result.R_change = result.rig.T_body_lidar.rotation() * config.rig.T_body_lidar.rotation().inverse();
+  result.R_change =
+      result.rig.T_body_lidar.rotation() * config.rig.T_body_lidar.rotation().inverse();
   return result;
 }
 

@@ -21,13 +21,14 @@ TEST(CalibrateCli, FindsTheTimeOffsetAndRotationOfATypicalRig) {
   test::TempDir dir;
   const auto sim = dir.file("sim");
   ASSERT_EQ(test::runTaiga("simulate --scenario handheld-loop --realism typical --duration 20 "
-                           "--beams 32 --seed 5 --out " + sim.string())
+                           "--beams 32 --seed 5 --out " +
+                           sim.string())
                 .exit_code,
             0);
   const auto out = dir.file("calibrated");
-  const test::TaigaResult r = test::runTaiga("calibrate " + (sim / "recording.bag").string() +
-                                             " --config " + (sim / "rig.yaml").string() +
-                                             " --out " + out.string());
+  const test::TaigaResult r =
+      test::runTaiga("calibrate " + (sim / "recording.bag").string() + " --config " +
+                     (sim / "rig.yaml").string() + " --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("offset     rig.lidar_time_offset_s"));
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "calibration.json"));
@@ -53,9 +54,10 @@ TEST(CalibrateCli, ARecordingWithoutAnImuIsBadInput) {
   const auto sim = dir.file("sim");
   const auto overrides = dir.file("no_imu.yaml");
   std::ofstream(overrides) << "output:\n  imu: false\n";
-  const test::TaigaResult s = test::runTaiga("simulate --scenario mixed --duration 3 --beams 16 "
-                                             "--columns 512 --overrides " + overrides.string() +
-                                             " --out " + sim.string());
+  const test::TaigaResult s = test::runTaiga(
+      "simulate --scenario mixed --duration 3 --beams 16 "
+      "--columns 512 --overrides " +
+      overrides.string() + " --out " + sim.string());
   ASSERT_EQ(s.exit_code, 0) << s.output;
   const test::TaigaResult r = test::runTaiga("calibrate " + (sim / "recording.bag").string() +
                                              " --out " + dir.file("out").string());

@@ -30,7 +30,9 @@ struct Motion {
         amplitude().cwiseProduct(rate()).cwiseProduct((rate() * t).array().cos().matrix());
     return lie::SO3::rightJacobian(theta) * theta_dot;
   }
-  Vector3d p(double t) const { return {1.2 * t + 0.3 * std::sin(0.9 * t), 0.5 * std::sin(0.5 * t), 0.05 * std::sin(2.1 * t)}; }
+  Vector3d p(double t) const {
+    return {1.2 * t + 0.3 * std::sin(0.9 * t), 0.5 * std::sin(0.5 * t), 0.05 * std::sin(2.1 * t)};
+  }
   Vector3d a(double t) const {
     return {-0.3 * 0.81 * std::sin(0.9 * t), -0.5 * 0.25 * std::sin(0.5 * t),
             -0.05 * 4.41 * std::sin(2.1 * t)};
@@ -55,8 +57,7 @@ LeverArmInput simulate(const Motion& m, const Vector3d& d_true, const Vector3d& 
   for (double t = 0.5; t < 30.0; t += 0.1) {
     if (std::fmod(t, 7.0) < 0.1) in.chains.emplace_back();  // a scan not registered now and then
     // The registration puts the body where the configured lever arm puts it: p_B + R d.
-    in.chains.back().push_back(
-        {t, lie::SE3(m.R(t), m.p(t) + m.R(t) * d_true + noise3(0.002))});
+    in.chains.back().push_back({t, lie::SE3(m.R(t), m.p(t) + m.R(t) * d_true + noise3(0.002))});
   }
   return in;
 }
@@ -76,7 +77,8 @@ TEST(LeverArm, FindsTheLeverArmWhereTheRigTurnsAboutAllAxes) {
 TEST(LeverArm, YawOnlyHoldsTheVerticalComponent) {
   // Turning about z moves the lever arm's x and y, never its z: z is held and reported.
   const Vector3d d_true(0.02, -0.05, 0.03);
-  const LeverArmEstimate e = estimateLeverArm(simulate(Motion{.yaw_only = true}, d_true, Vector3d::Zero(), 3));
+  const LeverArmEstimate e =
+      estimateLeverArm(simulate(Motion{.yaw_only = true}, d_true, Vector3d::Zero(), 3));
   EXPECT_TRUE(e.observable(0));
   EXPECT_TRUE(e.observable(1));
   EXPECT_FALSE(e.observable(2));

@@ -41,16 +41,22 @@ struct Data {
 Data simulate(const Truth& truth, unsigned seed, double duration_s = 30.0) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
-  auto noise3 = [&](double sigma) -> Vector3d { return Vector3d(normal(rng), normal(rng), normal(rng)) * sigma; };
+  auto noise3 = [&](double sigma) -> Vector3d {
+    return Vector3d(normal(rng), normal(rng), normal(rng)) * sigma;
+  };
   Data d;
   // True attitude on a 1 kHz grid of the IMU clock (midpoint rule), gyro readings at 400 Hz.
   constexpr double kFine_s = 0.001;
   std::vector<lie::SO3> attitude{lie::SO3()};
   for (double t = 0.0; t < duration_s + 1.0; t += kFine_s)
-    attitude.push_back(attitude.back() * lie::SO3::Exp(trueRate(t + 0.5 * kFine_s, truth.yaw_only) * kFine_s));
+    attitude.push_back(attitude.back() *
+                       lie::SO3::Exp(trueRate(t + 0.5 * kFine_s, truth.yaw_only) * kFine_s));
   for (double t = 0.0; t < duration_s + 1.0; t += 0.0025)
-    d.gyro.push_back({t, trueRate(t, truth.yaw_only) + truth.bias_radps + noise3(truth.gyro_noise_radps)});
-  auto at = [&](double t_imu) { return attitude[static_cast<std::size_t>(std::lround(t_imu / kFine_s))]; };
+    d.gyro.push_back(
+        {t, trueRate(t, truth.yaw_only) + truth.bias_radps + noise3(truth.gyro_noise_radps)});
+  auto at = [&](double t_imu) {
+    return attitude[static_cast<std::size_t>(std::lround(t_imu / kFine_s))];
+  };
   // Registration at 10 Hz, labelled on the odometry's clock (true IMU time - offset), in the
   // configured body frame: R_reg = R_true * R_c (so that dR_true = R_c dR_reg R_c^T).
   std::vector<lie::SO3> registered;
@@ -60,12 +66,14 @@ Data simulate(const Truth& truth, unsigned seed, double duration_s = 30.0) {
     registered.push_back(at(t) * truth.R_c * lie::SO3::Exp(noise3(truth.pose_noise_rad)));
   }
   for (std::size_t k = 0; k + 1 < registered.size(); ++k)
-    d.increments.push_back({labels[k], labels[k + 1],
-                            (registered[k].inverse() * registered[k + 1]).Log()});
+    d.increments.push_back(
+        {labels[k], labels[k + 1], (registered[k].inverse() * registered[k + 1]).Log()});
   return d;
 }
 
-double angleDeg(const lie::SO3& a, const lie::SO3& b) { return (a.inverse() * b).angle() * kDegPerRad; }
+double angleDeg(const lie::SO3& a, const lie::SO3& b) {
+  return (a.inverse() * b).angle() * kDegPerRad;
+}
 
 TEST(IntegrateGyro, ConstantRateGivesItsRotation) {
   std::vector<GyroReading> gyro;
@@ -125,8 +133,11 @@ TEST(TimeRotation, NoMotionIsReportedNotGuessed) {
   // Standing still: the gyro reads its bias and noise, the registration its noise.
   std::mt19937_64 rng(6);
   std::normal_distribution<double> normal(0.0, 1.0);
-  auto noise3 = [&](double sigma) -> Vector3d { return Vector3d(normal(rng), normal(rng), normal(rng)) * sigma; };
-  for (GyroReading& g : d.gyro) g.omega_body_radps = truth.bias_radps + noise3(truth.gyro_noise_radps);
+  auto noise3 = [&](double sigma) -> Vector3d {
+    return Vector3d(normal(rng), normal(rng), normal(rng)) * sigma;
+  };
+  for (GyroReading& g : d.gyro)
+    g.omega_body_radps = truth.bias_radps + noise3(truth.gyro_noise_radps);
   for (RotationIncrement& inc : d.increments) inc.theta_body_rad = noise3(truth.pose_noise_rad);
   const TimeRotationEstimate e = estimateTimeRotation(d.increments, d.gyro);
   EXPECT_FALSE(e.offset_observable);

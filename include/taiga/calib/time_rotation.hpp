@@ -80,7 +80,8 @@ TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& 
                                           const TimeRotationOptions& options = {});
 
 /// The gyro's rotation over [t0_s, t1_s] with `bias` removed, the readings linear between their
-/// stamps as in the odometry (imu/readings.hpp). Readings must be sorted by time and cover the interval.
+/// stamps as in the odometry (imu/readings.hpp). Readings must be sorted by time and cover the
+/// interval.
 lie::SO3 integrateGyro(const std::vector<GyroReading>& gyro, double t0_s, double t1_s,
                        const Eigen::Vector3d& bias_radps);
 

@@ -10,25 +10,28 @@
 // its stamp is half a period late against this convention; the calibrated time offset takes that
 // up. Before the first reading and after the last, the nearest one holds.
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cstddef>
 #include <type_traits>
 
+#include "taiga/core/sensor_samples.hpp"
+
 namespace taiga::imu {
 
 /// Calls piece(t_from_s, t_to_s, mean) for the pieces of [t0_s, t1_s] split at the readings'
-/// stamps, in order, with `mean` the mean of value(reading) over the piece. `samples` (anything indexable
-/// with .t_s) must be sorted by time.
+/// stamps, in order, with `mean` the mean of value(reading) over the piece. `samples` (anything
+/// indexable with .t_s) must be sorted by time.
 template <class Samples, class Value, class Piece>
 void forEachPiece(const Samples& samples, double t0_s, double t1_s, Value value, Piece piece) {
   const std::size_t n = samples.size();
   if (n == 0 || !(t1_s > t0_s)) return;
   using V = std::decay_t<decltype(value(samples[0]))>;
   // The first reading after t0_s.
-  std::size_t next = static_cast<std::size_t>(
-      std::upper_bound(samples.begin(), samples.end(), t0_s,
-                       [](double t, const auto& s) { return t < s.t_s; }) -
-      samples.begin());
+  std::size_t next =
+      static_cast<std::size_t>(std::upper_bound(samples.begin(), samples.end(), t0_s,
+                                                [](double t, const auto& s) { return t < s.t_s; }) -
+                               samples.begin());
   // The signal at t, for t between readings next - 1 and next.
   auto at = [&](double t) -> V {
     if (next == 0) return value(samples[0]);
@@ -44,6 +47,13 @@ void forEachPiece(const Samples& samples, double t0_s, double t1_s, Value value,
     t = t_next;
     ++next;
   }
+}
+
+/// A reading's acceleration and angular velocity stacked, [a; w]: the value forEachPiece averages
+/// for propagation and preintegration.
+using AccelGyro = Eigen::Matrix<double, 6, 1>;
+inline AccelGyro accelGyro(const ImuSample& s) {
+  return (AccelGyro() << s.acceleration_imu_mps2, s.angular_velocity_imu_radps).finished();
 }
 
 }  // namespace taiga::imu

@@ -33,9 +33,9 @@ struct CalibrationPass {
 };
 
 struct SelfCalibration {
-  RigConfig rig;                  ///< the configured rig with the offset and rotation corrected
-  double offset_change_s = 0.0;   ///< rig.lidar_time_offset_s minus the configured one
-  lie::SO3 R_change;              ///< R_body_lidar = R_change * R_body_lidar_configured
+  RigConfig rig;                     ///< the configured rig with the offset and rotation corrected
+  double offset_change_s = 0.0;      ///< rig.lidar_time_offset_s minus the configured one
+  lie::SO3 R_change;                 ///< R_body_lidar = R_change * R_body_lidar_configured
   calib::TimeRotationEstimate last;  ///< the last pass's estimate: its sigmas and observability
   /// The lever arm from the last pass, reported and not applied to `rig` (self_calibration.cpp);
   /// empty when it could not be estimated (lever_arm_failed says why).
