@@ -75,7 +75,8 @@ nlohmann::json report(const std::string& recording, const SystemConfig& configur
   j["advice"] = e.advice;
   nlohmann::json passes = nlohmann::json::array();
   for (const pipeline::CalibrationPass& p : c.passes)
-    passes.push_back({{"scans", p.scans},
+    passes.push_back({{"odometry", p.odometry},
+                      {"scans", p.scans},
                       {"offset_change_s", p.failed.empty() ? p.estimate.offset_s : 0.0},
                       {"rotation_change_deg",
                        p.failed.empty() ? p.estimate.R_correction.angle() * kDegPerRad : 0.0},

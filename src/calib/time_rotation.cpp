@@ -448,6 +448,10 @@ TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& 
     sum_dt2 += problem.duration(k) * problem.duration(k);
   }
   e.residual_rms_radps = std::sqrt(sum_r2 / sum_dt2);
+  double sum_signal2 = 0.0;
+  for (std::size_t k = 0; k < problem.size(); ++k)
+    sum_signal2 += problem.increment(k).theta_body_rad.squaredNorm();
+  e.signal_rms_radps = std::sqrt(sum_signal2 / sum_dt2);
   e.advice = advice(e);
   return e;
 }

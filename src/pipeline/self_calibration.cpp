@@ -31,9 +31,10 @@ bool measured(const ScanOutcome& o) {
 /// registrations' rotation increments between consecutive measured scans, and the gyro readings
 /// around them.
 PassData runPass(const std::filesystem::path& path, const SystemConfig& config,
-                 const RigConfig& rig, double from_s, double to_s, double margin_s) {
+                 const RigConfig& rig, bool lidar_only, double from_s, double to_s,
+                 double margin_s) {
   io::Recording recording = io::openRecording(path, config.recording, rig);
-  Odometry odometry(config.odometry, rig, /*lidar_only=*/false);
+  Odometry odometry(config.odometry, rig, lidar_only);
   const Eigen::Matrix3d R_body_imu = rig.T_body_imu.rotation().matrix();
   PassData data;
   std::optional<double> first_scan_s;
@@ -67,7 +68,7 @@ PassData runPass(const std::filesystem::path& path, const SystemConfig& config,
           {.t_s = imu->t_s,
            .acceleration_imu_mps2 = R_body_imu * imu->acceleration_imu_mps2,
            .angular_velocity_imu_radps = data.gyro.back().omega_body_radps});
-      odometry.addImu(*imu);
+      if (!lidar_only) odometry.addImu(*imu);
       if (first_scan_s && imu->t_s > *first_scan_s + to_s + margin_s) break;
     } else if (const auto* scan = std::get_if<io::Scan>(&*event)) {
       if (!first_scan_s) first_scan_s = scan->t_end_s;
@@ -97,6 +98,12 @@ std::string describe(const calib::TimeRotationEstimate& e) {
       1e3 * e.offset_s, 1e3 * e.offset_sigma_s, e.offset_observable ? "" : ", not observable",
       e.R_correction.angle() * kDegPerRad, e.rotation_sigma_rad.maxCoeff() * kDegPerRad,
       e.rotation_observable.count(), e.residual_rms_radps * kDegPerRad, e.increments_used);
+}
+
+/// The registrations' rotations agree with the gyro's by less than half their size: not noise but
+/// a rig too wrong for the IMU to start them (or a gross error of the gyro's frame).
+bool disagrees(const calib::TimeRotationEstimate& e) {
+  return e.residual_rms_radps > 0.5 * e.signal_rms_radps;
 }
 
 /// A pass that moved nothing beyond its own 1-sigma: the estimate has converged.
@@ -138,28 +145,52 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
       .max_rotation_sigma_rad = config.calibration.max_rotation_sigma_deg * kRadPerDeg};
   const double margin_s = estimator.max_offset_s + 0.5;
   PassData last_data;
-  for (int pass = 0; pass < options.max_passes; ++pass) {
-    CalibrationPass p;
+  auto pass = [&](bool lidar_only, const calib::TimeRotationOptions& limits) {
+    CalibrationPass p{.odometry = lidar_only ? "lidar-only" : "lidar-inertial"};
     try {
-      PassData data = runPass(recording, config, result.rig, result.from_s, result.to_s, margin_s);
+      PassData data = runPass(recording, config, result.rig, lidar_only, result.from_s,
+                              result.to_s, margin_s);
       p.scans = data.scans;
       if (data.gyro.empty())
         throw InputError("the recording has no IMU readings in the stretch: nothing to calibrate");
-      p.estimate = calib::estimateTimeRotation(data.increments, data.gyro, estimator);
-      last_data = std::move(data);
+      p.estimate = calib::estimateTimeRotation(data.increments, data.gyro, limits);
+      if (!lidar_only) last_data = std::move(data);
     } catch (const InputError& e) {
-      if (pass == 0)
+      if (result.passes.empty())
         throw InputError(fmt::format("{}: calibration failed: {}", recording.string(), e.what()));
       p.failed = e.what();
     }
-    logger().info("calibration pass {}: {}", pass + 1,
+    logger().info("calibration pass {} ({}): {}", result.passes.size() + 1, p.odometry,
                   p.failed.empty() ? describe(p.estimate) : p.failed);
     result.passes.push_back(p);
+    return p;
+  };
+  for (int i = 0; i < options.max_passes; ++i) {
+    CalibrationPass p = pass(false, estimator);
     if (!p.failed.empty()) break;  // keep the previous pass's rig
+    if (i == 0 && disagrees(p.estimate)) {
+      // Coarse: the rotation only, whatever its sigma (degrees are enough for the IMU's
+      // prediction to start the registrations again).
+      calib::TimeRotationOptions coarse = estimator;
+      coarse.max_rotation_sigma_rad = 0.1;
+      coarse.max_offset_sigma_s = 0.0;
+      const CalibrationPass c = pass(true, coarse);
+      if (c.failed.empty()) {
+        result.rig = corrected(result.rig, c.estimate);
+        continue;
+      }
+    }
     result.rig = corrected(result.rig, p.estimate);
     result.last = p.estimate;
     if (settled(p.estimate)) break;
   }
+  if (disagrees(result.last))
+    result.last.advice = fmt::format(
+        "the registrations and the gyro disagree beyond noise ({:.1f} deg/s RMS against a "
+        "signal of {:.1f} deg/s): check rig.T_body_lidar and rig.T_body_imu for a gross error (a "
+        "90 or 180 deg mounting, swapped axes); {}",
+        result.last.residual_rms_radps * kDegPerRad, result.last.signal_rms_radps * kDegPerRad,
+        result.last.advice);
   estimateLeverArm(last_data, config.calibration.max_translation_sigma_m, result);
   result.offset_change_s = result.rig.lidar_time_offset_s - config.rig.lidar_time_offset_s;
   result.R_change =

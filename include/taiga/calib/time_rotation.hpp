@@ -68,6 +68,9 @@ struct TimeRotationEstimate {
   Eigen::Vector3<bool> rotation_observable{false, false, false};
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
   double residual_rms_radps = 0.0;
+  /// RMS of the rate the registration saw (|R_c l| over each increment's duration): the signal
+  /// the residual is to be compared with.
+  double signal_rms_radps = 0.0;
   std::size_t increments_used = 0, increments_dropped = 0;
   std::vector<CostPoint> cost_curve;
   /// What motion would make the unobservable quantities observable; empty when all were.

@@ -6,8 +6,10 @@
 // its propagation deskews the scan), so a wrong rig pulls them a little towards itself: each pass
 // runs again with the rig the previous one found, until a pass changes nothing beyond its own
 // 1-sigma (a wrong offset shrinks about fourfold per pass).
-// A lidar-only first pass was tried and dropped: at 10 Hz its constant-velocity deskew leaves
-// errors of degrees per scan in a handheld's sway, as large as the signal.
+// When the first pass's registrations disagree with the gyro beyond noise (a gross mounting
+// error, 90 or 180 deg, throws the IMU's prediction off), a lidar-only pass, which needs no rig,
+// finds the mounting coarsely first. It is not the first pass always: at 10 Hz its
+// constant-velocity deskew leaves errors of degrees per scan in a handheld's sway.
 
 #include <filesystem>
 #include <optional>
@@ -27,6 +29,7 @@ struct SelfCalibrationOptions {
 };
 
 struct CalibrationPass {
+  std::string odometry = "lidar-inertial";  ///< or "lidar-only" (the coarse pass)
   std::size_t scans = 0;
   calib::TimeRotationEstimate estimate;  ///< relative to the pass's rig
   std::string failed;                    ///< why the pass gave no estimate; empty when it did
