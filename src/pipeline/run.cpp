@@ -156,8 +156,14 @@ RunSummary runOdometry(const std::filesystem::path& recording_path,
   createOutputDirectory(out);
   SystemConfig config = configured;
   std::optional<CalibrationRunReport> calibration;
-  if (config.calibration.at_start && config.odometry.imu_use != "lidar_only")
-    calibration = calibrateAtStart(recording_path, config);
+  if (config.calibration.at_start && config.odometry.imu_use != "lidar_only") {
+    if (options.realtime)  // a live sensor gives no stretch to read ahead
+      calibration = CalibrationRunReport{
+          .skipped = "not under --realtime, which replays the recording as a live sensor would "
+                     "deliver it; calibrate with taiga calibrate first"};
+    else
+      calibration = calibrateAtStart(recording_path, config);
+  }
   io::Recording recording = io::openRecording(recording_path, config.recording, config.rig);
   std::deque<io::RecordingEvent> read_ahead;
   SlamSystem slam(config,
