@@ -331,6 +331,43 @@ bool determined(double change, double variance, double max_sigma) {
   return sigma <= max_sigma || (sigma <= 10.0 * max_sigma && std::abs(change) >= 3.0 * sigma);
 }
 
+/// The parameters left free: the offset when observable, the rotation directions the motion
+/// determined (the others go to `held`), the gyro bias always.
+Basis estimationBasis(bool offset_observable, const Excitation& excitation, const Vector3d& theta,
+                      const TimeRotationOptions& options, std::vector<Vector3d>* held) {
+  Basis basis(kParams, 0);
+  auto addColumn = [&](const ParamVector& column) {
+    basis.conservativeResize(Eigen::NoChange, basis.cols() + 1);
+    basis.col(basis.cols() - 1) = column;
+  };
+  if (offset_observable) addColumn(ParamVector::Unit(0));
+  for (int i = 0; i < 3; ++i) {
+    const Vector3d v = excitation.rotation_directions.col(i);
+    if (determined(v.dot(theta), excitation.rotation_variances_rad2(i),
+                   options.max_rotation_sigma_rad)) {
+      ParamVector column = ParamVector::Zero();
+      column.segment<3>(1) = v;
+      addColumn(column);
+    } else {
+      held->push_back(v);
+    }
+  }
+  for (int i = 0; i < 3; ++i) addColumn(ParamVector::Unit(4 + i));
+  return basis;
+}
+
+/// RMS over the increments' durations of residual (1) and of the rate the registration saw.
+void rmsRates(const Problem& p, const State& s, double* residual_radps, double* signal_radps) {
+  double sum_r2 = 0.0, sum_signal2 = 0.0, sum_dt2 = 0.0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    sum_r2 += p.residual(k, s).squaredNorm();
+    sum_signal2 += p.increment(k).theta_body_rad.squaredNorm();
+    sum_dt2 += p.duration(k) * p.duration(k);
+  }
+  *residual_radps = std::sqrt(sum_r2 / sum_dt2);
+  *signal_radps = std::sqrt(sum_signal2 / sum_dt2);
+}
+
 const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
 
 std::string advice(const TimeRotationEstimate& e) {
@@ -402,26 +439,9 @@ TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& 
       std::abs(s.offset_s) < options.max_offset_s;
   if (!e.offset_observable) s = alignAtOffset(problem, 0.0, &e.residual_rms_radps);
   // Rotation: the directions the motion determined are estimated, the others held.
-  std::vector<Eigen::Vector3d> held;
-  Basis basis(kParams, 0);
-  auto addColumn = [&](const ParamVector& column) {
-    basis.conservativeResize(Eigen::NoChange, basis.cols() + 1);
-    basis.col(basis.cols() - 1) = column;
-  };
-  if (e.offset_observable) addColumn(ParamVector::Unit(0));
-  const Vector3d theta = lie::SO3::fromMatrix(s.R_c).Log();
-  for (int i = 0; i < 3; ++i) {
-    const Vector3d v = excitation.rotation_directions.col(i);
-    if (determined(v.dot(theta), excitation.rotation_variances_rad2(i),
-                   options.max_rotation_sigma_rad)) {
-      ParamVector column = ParamVector::Zero();
-      column.segment<3>(1) = v;
-      addColumn(column);
-    } else {
-      held.push_back(v);
-    }
-  }
-  for (int i = 0; i < 3; ++i) addColumn(ParamVector::Unit(4 + i));
+  std::vector<Vector3d> held;
+  const Basis basis = estimationBasis(e.offset_observable, excitation,
+                                      lie::SO3::fromMatrix(s.R_c).Log(), options, &held);
   s.R_c = withoutRotationAbout(s.R_c, held);
   s = refine(problem, s, basis);
   ParamMatrix cov = covariance(problem, s, basis);
@@ -442,16 +462,7 @@ TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& 
     for (int axis = 0; axis < 3; ++axis)
       if (v(axis) * v(axis) > 1.0 / 3.0) e.rotation_observable(axis) = false;
   e.gyro_bias_radps = s.bias_radps;
-  double sum_r2 = 0.0, sum_dt2 = 0.0;
-  for (std::size_t k = 0; k < problem.size(); ++k) {
-    sum_r2 += problem.residual(k, s).squaredNorm();
-    sum_dt2 += problem.duration(k) * problem.duration(k);
-  }
-  e.residual_rms_radps = std::sqrt(sum_r2 / sum_dt2);
-  double sum_signal2 = 0.0;
-  for (std::size_t k = 0; k < problem.size(); ++k)
-    sum_signal2 += problem.increment(k).theta_body_rad.squaredNorm();
-  e.signal_rms_radps = std::sqrt(sum_signal2 / sum_dt2);
+  rmsRates(problem, s, &e.residual_rms_radps, &e.signal_rms_radps);
   e.advice = advice(e);
   return e;
 }
