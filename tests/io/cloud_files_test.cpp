@@ -216,5 +216,16 @@ TEST(CloudFiles, AsciiPlyEndingBeforeItsLastVertexIsAnError) {
   }
 }
 
+TEST(CloudFiles, BinaryPlyElementWithoutPropertiesIsSkippedAtOnce) {
+  // Found by fuzz_cloud_files: an element claiming 3e10 items and no properties was skipped one
+  // empty item at a time (minutes); it takes no bytes, so it is skipped at once.
+  const std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement junk 30000000000\nelement vertex 1\nproperty "
+      "float x\nproperty float y\nproperty float z\nend_header\n" +
+      std::string(12, '\0');
+  const LoadedPoints loaded = parsePly(ply);
+  EXPECT_EQ(loaded.packed.width, 1u);
+}
+
 }  // namespace
 }  // namespace taiga::io
