@@ -108,9 +108,7 @@ void writeCorrectedConfig(const std::filesystem::path& path, SystemConfig config
 }
 
 std::string axes(const Eigen::Vector3<bool>& observable) {
-  std::string names;
-  for (int i = 0; i < 3; ++i)
-    if (observable(i)) names += "xyz"[i];
+  const std::string names = calib::axisNames(observable);
   return names.empty() ? "none" : names;
 }
 

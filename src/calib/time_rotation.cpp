@@ -388,6 +388,13 @@ std::string advice(const TimeRotationEstimate& e) {
 
 }  // namespace
 
+std::string axisNames(const Eigen::Vector3<bool>& which) {
+  std::string names;
+  for (int axis = 0; axis < 3; ++axis)
+    if (which(axis)) names += axisName(axis);
+  return names;
+}
+
 lie::SO3 integrateGyro(const std::vector<GyroReading>& gyro, double t0_s, double t1_s,
                        const Eigen::Vector3d& bias_radps) {
   if (gyro.empty() || gyro.front().t_s > t0_s || gyro.back().t_s < t1_s)

@@ -13,6 +13,7 @@
 #include "run_georef.hpp"
 #include "run_health.hpp"
 #include "run_outputs.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/core/percentile.hpp"
@@ -20,7 +21,6 @@
 #include "taiga/io/moving_boxes.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/mapping/map_export.hpp"
-#include "taiga/core/angles.hpp"
 #include "taiga/pipeline/self_calibration.hpp"
 #include "taiga/pipeline/slam_system.hpp"
 
@@ -137,8 +137,7 @@ CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording, Sy
     report.offset_observable = c.last.offset_observable;
     report.rotation_change_deg = c.R_change.angle() * kDegPerRad;
     report.rotation_sigma_deg = c.last.rotation_sigma_rad * kDegPerRad;
-    for (int axis = 0; axis < 3; ++axis)
-      if (c.last.rotation_observable(axis)) report.rotation_observable_axes += "xyz"[axis];
+    report.rotation_observable_axes = calib::axisNames(c.last.rotation_observable);
     report.advice = c.last.advice;
   } catch (const std::exception& e) {  // bad input or a pass that failed: the run goes on
     report.skipped = e.what();

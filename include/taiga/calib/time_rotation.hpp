@@ -77,6 +77,9 @@ struct TimeRotationEstimate {
   std::string advice;
 };
 
+/// The names of the axes set in `which`, e.g. "xz"; empty when none.
+std::string axisNames(const Eigen::Vector3<bool>& which);
+
 /// Throws InputError when fewer than 20 increments or no gyro readings overlap them.
 TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& increments,
                                           const std::vector<GyroReading>& gyro,
