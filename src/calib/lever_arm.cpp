@@ -31,13 +31,10 @@ std::vector<Step> steps(const LeverArmInput& in, Eigen::Index* unknowns) {
   Eigen::Index column = kFirstVelocity;
   for (const std::vector<StampedPose>& chain : in.chains) {
     for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
-      imu::Preintegrator pre(in.bias_hat, in.noise);
-      imu::forEachPiece(in.imu_body, chain[k].t_s, chain[k + 1].t_s, imu::accelGyro,
-                        [&](double t0_s, double t1_s, const imu::AccelGyro& mean) {
-                          pre.integrate(mean.head<3>(), mean.tail<3>(), t1_s - t0_s);
-                        });
       out.push_back({&chain[k], &chain[k + 1], column + 3 * static_cast<Eigen::Index>(k),
-                     column + 3 * static_cast<Eigen::Index>(k + 1), pre});
+                     column + 3 * static_cast<Eigen::Index>(k + 1),
+                     imu::preintegrateReadings(in.imu_body, chain[k].t_s, chain[k + 1].t_s,
+                                               in.bias_hat, in.noise)});
     }
     if (chain.size() >= 2) column += 3 * static_cast<Eigen::Index>(chain.size());
   }

@@ -45,12 +45,7 @@ std::vector<ImuSample> ImuBuffer::signalOver(double t_from_s, double t_to_s) con
 imu::Preintegrator ImuBuffer::preintegrate(double t_from_s, double t_to_s,
                                            const imu::ImuBias& bias_hat,
                                            const imu::ImuNoise& noise) const {
-  imu::Preintegrator pre(bias_hat, noise);
-  imu::forEachPiece(samples_, t_from_s, t_to_s, imu::accelGyro,
-                    [&](double piece_from_s, double piece_to_s, const imu::AccelGyro& mean) {
-                      pre.integrate(mean.head<3>(), mean.tail<3>(), piece_to_s - piece_from_s);
-                    });
-  return pre;
+  return imu::preintegrateReadings(samples_, t_from_s, t_to_s, bias_hat, noise);
 }
 
 void ImuBuffer::dropBefore(double t_s) {

@@ -16,6 +16,7 @@
 #include <type_traits>
 
 #include "taiga/core/sensor_samples.hpp"
+#include "taiga/imu/preintegration.hpp"
 
 namespace taiga::imu {
 
@@ -54,6 +55,19 @@ void forEachPiece(const Samples& samples, double t0_s, double t1_s, Value value,
 using AccelGyro = Eigen::Matrix<double, 6, 1>;
 inline AccelGyro accelGyro(const ImuSample& s) {
   return (AccelGyro() << s.acceleration_imu_mps2, s.angular_velocity_imu_radps).finished();
+}
+
+/// The readings over [t0_s, t1_s] preintegrated ([Forster] Eq. 33), read as above: what the
+/// odometry's IMU factor and the lever-arm calibration both need.
+template <class Samples>
+Preintegrator preintegrateReadings(const Samples& samples, double t0_s, double t1_s,
+                                   const ImuBias& bias_hat, const ImuNoise& noise) {
+  Preintegrator pre(bias_hat, noise);
+  forEachPiece(samples, t0_s, t1_s, accelGyro,
+               [&](double piece_from_s, double piece_to_s, const AccelGyro& mean) {
+                 pre.integrate(mean.head<3>(), mean.tail<3>(), piece_to_s - piece_from_s);
+               });
+  return pre;
 }
 
 }  // namespace taiga::imu
