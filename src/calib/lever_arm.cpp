@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "taiga/calib/time_rotation.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/imu/readings.hpp"
 
@@ -110,14 +111,13 @@ LeverArmEstimate estimateLeverArm(const LeverArmInput& in, double max_sigma_m) {
   const Matrix3d cov = N.ldlt().solve(unit).topRows<3>();
   const Eigen::SelfAdjointEigenSolver<Matrix3d> eig(cov);
   LeverArmEstimate e;
-  e.observable.setConstant(true);
+  std::vector<Vector3d> held;
   for (int i = 0; i < 3; ++i) {
     if (std::sqrt(std::max(0.0, eig.eigenvalues()(i))) <= max_sigma_m) continue;
-    const Vector3d v = eig.eigenvectors().col(i);
-    held_prior += 1e12 * v * v.transpose();  // held at the configured value
-    for (int axis = 0; axis < 3; ++axis)
-      if (v(axis) * v(axis) > 1.0 / 3.0) e.observable(axis) = false;
+    held.push_back(eig.eigenvectors().col(i));
+    held_prior += 1e12 * held.back() * held.back().transpose();  // held at the configured value
   }
+  e.observable = axesNotHeld(held);
   if (!held_prior.isZero()) solve();
   e.correction_m = x.segment<3>(kLever);
   e.sigma_m = cov.diagonal().cwiseMax(0.0).cwiseSqrt();

@@ -388,6 +388,14 @@ std::string advice(const TimeRotationEstimate& e) {
 
 }  // namespace
 
+Eigen::Vector3<bool> axesNotHeld(const std::vector<Eigen::Vector3d>& held) {
+  Eigen::Vector3<bool> observable(true, true, true);
+  for (const Vector3d& v : held)
+    for (int axis = 0; axis < 3; ++axis)
+      if (v(axis) * v(axis) > 1.0 / 3.0) observable(axis) = false;
+  return observable;
+}
+
 std::string axisNames(const Eigen::Vector3<bool>& which) {
   std::string names;
   for (int axis = 0; axis < 3; ++axis)
@@ -464,10 +472,7 @@ TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& 
   }
   e.rotation_sigma_rad =
       cov.diagonal().segment<3>(1).cwiseMax(rotation_floor.diagonal()).cwiseSqrt();
-  e.rotation_observable.setConstant(true);
-  for (const Vector3d& v : held)
-    for (int axis = 0; axis < 3; ++axis)
-      if (v(axis) * v(axis) > 1.0 / 3.0) e.rotation_observable(axis) = false;
+  e.rotation_observable = axesNotHeld(held);
   e.gyro_bias_radps = s.bias_radps;
   rmsRates(problem, s, &e.residual_rms_radps, &e.signal_rms_radps);
   e.advice = advice(e);

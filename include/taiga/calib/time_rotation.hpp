@@ -77,6 +77,10 @@ struct TimeRotationEstimate {
   std::string advice;
 };
 
+/// The body axes still observable when the directions `held` were not: an axis is lost when a
+/// held direction leans on it by more than 1/3 of its square (for the rotation and the lever arm).
+Eigen::Vector3<bool> axesNotHeld(const std::vector<Eigen::Vector3d>& held);
+
 /// The names of the axes set in `which`, e.g. "xz"; empty when none.
 std::string axisNames(const Eigen::Vector3<bool>& which);
 
