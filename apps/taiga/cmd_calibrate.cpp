@@ -48,6 +48,35 @@ nlohmann::json leverArmJson(const pipeline::SelfCalibration& c) {
            "along the vertical even for a perfectly calibrated rig (docs/calibration.md)"}};
 }
 
+/// The gyro's noise density against the lidar (calib/gyro_noise.hpp), with the residual's
+/// variance per lag (the Allan-like curve it was fitted to).
+nlohmann::json gyroNoiseJson(const SystemConfig& configured, const pipeline::SelfCalibration& c) {
+  nlohmann::json j = {{"configured_radps_sqrthz", configured.odometry.imu.gyro_noise_density},
+                      {"verdict", calib::toString(c.gyro_noise_verdict.kind)},
+                      {"text", c.gyro_noise_verdict.text}};
+  if (c.gyro_noise_verdict.suggested > 0.0) j["suggested_radps_sqrthz"] = c.gyro_noise_verdict.suggested;
+  if (!c.gyro_noise) return j;
+  const calib::GyroNoiseEstimate& e = *c.gyro_noise;
+  j["measured_radps_sqrthz"] = e.density_radps_sqrthz;
+  j["sigma_radps_sqrthz"] = e.density_sigma;
+  j["rate_error_radps"] = e.rate_error_radps;
+  j["registration_sigma_deg"] = e.registration_sigma_rad * kDegPerRad;
+  const Eigen::Matrix3d& A = e.rate_error_matrix;
+  j["rate_error_matrix"] = {asVector(A.row(0)), asVector(A.row(1)), asVector(A.row(2))};
+  nlohmann::json lags = nlohmann::json::array();
+  for (const calib::LagVariance& l : e.lags)
+    lags.push_back({{"lag_scans", l.lag_scans},
+                    {"tau_s", l.tau_s},
+                    {"variance_rad2", l.variance_rad2},
+                    {"model_rad2", l.model_rad2},
+                    {"samples", l.samples}});
+  j["lags"] = lags;
+  j["accelerometer"] =
+      "not measured: its white noise moves the body by less than a millimetre over the lags the "
+      "registrations resolve";
+  return j;
+}
+
 nlohmann::json report(const std::string& recording, const SystemConfig& configured,
                       const pipeline::SelfCalibration& c) {
   const calib::TimeRotationEstimate& e = c.last;
@@ -68,6 +97,7 @@ nlohmann::json report(const std::string& recording, const SystemConfig& configur
                    {"sigma_deg", asVector(degrees(e.rotation_sigma_rad))},
                    {"observable_about_body_xyz", observable}};
   j["translation"] = leverArmJson(c);
+  j["gyro_noise"] = gyroNoiseJson(configured, c);
   j["gyro_bias_radps"] = asVector(e.gyro_bias_radps);
   j["residual_rms_deg_s"] = e.residual_rms_radps * kDegPerRad;
   j["increments_used"] = e.increments_used;
@@ -97,12 +127,16 @@ nlohmann::json report(const std::string& recording, const SystemConfig& configur
 void writeCorrectedConfig(const std::filesystem::path& path, SystemConfig config,
                           const pipeline::SelfCalibration& c, const std::string& recording) {
   config.rig = c.rig;
+  const bool noise = c.gyro_noise_verdict.kind == calib::NoiseVerdict::Kind::kUnderstated;
+  if (noise) config.odometry.imu.gyro_noise_density = c.gyro_noise_verdict.suggested;
   std::ofstream out(path);
   out << fmt::format(
       "# Written by taiga calibrate from {} ({:.0f}-{:.0f} s): rig.lidar_time_offset_s and the\n"
       "# rotation of rig.T_body_lidar estimated, everything else (the lever arm too) as\n"
-      "# configured. calibration.json has the values, their 1-sigma and what the motion showed.\n",
-      recording, c.from_s, c.to_s);
+      "# configured{}. calibration.json has the values, their 1-sigma and what the motion showed.\n",
+      recording, c.from_s, c.to_s,
+      noise ? "\n# but odometry.imu.gyro_noise_density: measured, the configured one was understated"
+            : "");
   out << io::writeConfigYaml(config);
   if (!out) throw InputError(fmt::format("{}: cannot write", path.string()));
 }
@@ -148,6 +182,10 @@ int run(const CalibrateOptions& options) {
   fmt::print("gyro       bias {:.5f} {:.5f} {:.5f} rad/s; residual {:.3f} deg/s RMS\n",
              e.gyro_bias_radps.x(), e.gyro_bias_radps.y(), e.gyro_bias_radps.z(),
              e.residual_rms_radps * kDegPerRad);
+  fmt::print("gyro noise {}{}\n", c.gyro_noise_verdict.text,
+             c.gyro_noise_verdict.kind == calib::NoiseVerdict::Kind::kUnderstated
+                 ? " (written into rig.yaml)"
+                 : "");
   if (!e.advice.empty()) fmt::print("advice     {}\n", e.advice);
   if (options.plots) {
     const eval::PlotOutcome plots = eval::makePlots(j.dump(), out, "calibration_plot_data.json");

@@ -76,6 +76,7 @@ void printCalibration(const pipeline::CalibrationRunReport& c) {
       1e3 * c.offset_sigma_s, c.offset_observable ? "" : ", not observable: kept",
       c.rotation_change_deg, c.rotation_observable_axes.empty() ? "none" : c.rotation_observable_axes);
   if (!c.advice.empty()) fmt::print("           {}\n", c.advice);
+  if (!c.gyro_noise_text.empty()) fmt::print("           {}\n", c.gyro_noise_text);
 }
 
 int run(const RunOptions& options) {

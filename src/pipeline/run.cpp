@@ -139,6 +139,15 @@ CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording, Sy
     report.rotation_sigma_deg = c.last.rotation_sigma_rad * kDegPerRad;
     report.rotation_observable_axes = calib::axisNames(c.last.rotation_observable);
     report.advice = c.last.advice;
+    report.gyro_noise_verdict = calib::toString(c.gyro_noise_verdict.kind);
+    report.gyro_noise_text = c.gyro_noise_verdict.text;
+    report.gyro_noise_suggested = c.gyro_noise_verdict.suggested;
+    if (c.gyro_noise) {
+      report.gyro_noise_measured = c.gyro_noise->density_radps_sqrthz;
+      report.gyro_noise_sigma = c.gyro_noise->density_sigma;
+    }
+    if (c.gyro_noise_verdict.kind == calib::NoiseVerdict::Kind::kUnderstated)
+      logger().warn("{}", c.gyro_noise_verdict.text);
   } catch (const std::exception& e) {  // bad input or a pass that failed: the run goes on
     report.skipped = e.what();
     logger().warn("calibration at the start skipped, the configured rig is used: {}", e.what());

@@ -75,7 +75,13 @@ nlohmann::ordered_json calibrationJson(const CalibrationRunReport& c) {
           {"rotation_change_deg", c.rotation_change_deg},
           {"rotation_sigma_deg", {sigma.x(), sigma.y(), sigma.z()}},
           {"rotation_observable_axes", c.rotation_observable_axes},
-          {"advice", c.advice}};
+          {"advice", c.advice},
+          {"gyro_noise",
+           {{"verdict", c.gyro_noise_verdict},
+            {"measured_radps_sqrthz", c.gyro_noise_measured},
+            {"sigma_radps_sqrthz", c.gyro_noise_sigma},
+            {"suggested_radps_sqrthz", c.gyro_noise_suggested},
+            {"text", c.gyro_noise_text}}}};
 }
 
 }  // namespace

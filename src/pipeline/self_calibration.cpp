@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 
+#include "taiga/calib/gyro_noise.hpp"
 #include "taiga/calib/lever_arm.hpp"
 #include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
@@ -131,6 +132,24 @@ void estimateLeverArm(PassData& data, double max_sigma_m, SelfCalibration& resul
   }
 }
 
+/// The gyro's noise density from the last pass's registrations against the gyro, judged against
+/// the configured one (the configuration's noise is what the odometry trusts).
+void estimateGyroNoise(const PassData& data, double configured, SelfCalibration& result) {
+  try {
+    const calib::GyroNoiseEstimate e = calib::estimateGyroNoise(
+        {.chains = data.lever_arm.chains,
+         .gyro = data.gyro,
+         .offset_s = result.last.offset_s,
+         .R_correction = result.last.R_correction,
+         .bias_radps = result.last.gyro_bias_radps});
+    result.gyro_noise_verdict = calib::judgeGyroNoise(e, configured);
+    logger().info("calibration: {}", result.gyro_noise_verdict.text);
+    result.gyro_noise = e;
+  } catch (const InputError& e) {
+    result.gyro_noise_verdict.text = fmt::format("gyro noise density not measured: {}", e.what());
+  }
+}
+
 }  // namespace
 
 SelfCalibration selfCalibrate(const std::filesystem::path& recording, const SystemConfig& config,
@@ -192,6 +211,7 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
         result.last.residual_rms_radps * kDegPerRad, result.last.signal_rms_radps * kDegPerRad,
         result.last.advice);
   estimateLeverArm(last_data, config.calibration.max_translation_sigma_m, result);
+  estimateGyroNoise(last_data, config.odometry.imu.gyro_noise_density, result);
   result.offset_change_s = result.rig.lidar_time_offset_s - config.rig.lidar_time_offset_s;
   result.R_change =
       result.rig.T_body_lidar.rotation() * config.rig.T_body_lidar.rotation().inverse();

@@ -11,6 +11,7 @@
 #include <iterator>
 #include <vector>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "../support/run_taiga.hpp"
@@ -47,10 +48,21 @@ TEST(CalibrateCli, FindsTheTimeOffsetAndRotationOfATypicalRig) {
   EXPECT_FALSE(j["translation"]["applied"].get<bool>());
   EXPECT_GE(j["passes"].size(), 2u);
   EXPECT_FALSE(j["cost_curve"]["offset_s"].empty());
-  // The corrected configuration is valid and says the offset.
+  // The gyro's true noise is twice rig.yaml's 2.5e-4 rad/s/sqrt(Hz); stamp jitter and the
+  // registrations' own errors add to what the odometry sees (docs/calibration.md, "IMU noise").
+  const nlohmann::json& noise = j["gyro_noise"];
+  EXPECT_EQ(noise["verdict"], "understated") << noise.dump();
+  const double measured = noise["measured_radps_sqrthz"].get<double>();
+  EXPECT_GT(measured, 1.6 * 2.5e-4);
+  EXPECT_LT(measured, 4.5 * 2.5e-4);
+  EXPECT_LT(noise["sigma_radps_sqrthz"].get<double>(), measured / 3.0);
+  // The corrected configuration is valid and says the offset and the measured density.
   const test::TaigaResult config = test::runTaiga("config " + (out / "rig.yaml").string());
   EXPECT_EQ(config.exit_code, 0) << config.output;
   EXPECT_THAT(config.output, HasSubstr("lidar_time_offset_s: 0.0"));
+  std::ostringstream suggested;
+  suggested << "gyro_noise_density: " << noise["suggested_radps_sqrthz"].get<double>();
+  EXPECT_THAT(config.output, HasSubstr(suggested.str()));
 
   // A lidar mounted 90 deg from what the rig says (the truth is the identity): the IMU's
   // prediction cannot start the registrations, and a lidar-only pass finds the mounting first.

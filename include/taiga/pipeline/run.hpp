@@ -110,6 +110,12 @@ struct CalibrationRunReport {
   Eigen::Vector3d rotation_sigma_deg = Eigen::Vector3d::Zero();  ///< about body x, y, z
   std::string rotation_observable_axes;  ///< e.g. "xyz", "xy", "" (none)
   std::string advice;                    ///< what motion would calibrate what was not observable
+  /// The gyro's noise density measured against the registrations (calib/gyro_noise.hpp) and the
+  /// verdict on odometry.imu.gyro_noise_density: reported, not applied (docs/calibration.md).
+  std::string gyro_noise_verdict = "undetermined";
+  std::string gyro_noise_text;
+  double gyro_noise_measured = 0.0, gyro_noise_sigma = 0.0;  ///< rad/s/sqrt(Hz); 0: not measured
+  double gyro_noise_suggested = 0.0;                          ///< 0 when consistent
 };
 
 struct RunSummary {

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "taiga/calib/gyro_noise.hpp"
 #include "taiga/calib/lever_arm.hpp"
 #include "taiga/calib/time_rotation.hpp"
 #include "taiga/core/system_config.hpp"
@@ -44,6 +45,11 @@ struct SelfCalibration {
   /// empty when it could not be estimated (lever_arm_failed says why).
   std::optional<calib::LeverArmEstimate> lever_arm;
   std::string lever_arm_failed;
+  /// The gyro's noise density measured in the last pass (empty when the chains were too short)
+  /// and what it says of the configured one (reported; `taiga calibrate` writes the suggestion
+  /// into its rig.yaml, `taiga run` does not apply it).
+  std::optional<calib::GyroNoiseEstimate> gyro_noise;
+  calib::NoiseVerdict gyro_noise_verdict;
   std::vector<CalibrationPass> passes;
   double from_s = 0.0, to_s = 0.0;  ///< the stretch used, recording time
 };
