@@ -29,23 +29,37 @@ struct Sample {
   double tau_s = 0.0;
   Vector3d r_rad = Vector3d::Zero();
   Vector3d theta_rad = Vector3d::Zero();  ///< the registrations' rotation over the lag
+  Vector3d rate_change_radps = Vector3d::Zero();  ///< the gyro's rate at the lag's end - start
 };
 
+/// The gyro's rate at t_s, linear between readings (sorted; t_s within them).
+Vector3d rateAt(const std::vector<GyroReading>& gyro, double t_s) {
+  const auto after = std::lower_bound(gyro.begin(), gyro.end(), t_s,
+                                      [](const GyroReading& g, double t) { return g.t_s < t; });
+  if (after == gyro.begin()) return after->omega_body_radps;
+  if (after == gyro.end()) return gyro.back().omega_body_radps;
+  const auto before = after - 1;
+  const double span_s = after->t_s - before->t_s;
+  const double w = span_s > 0.0 ? (t_s - before->t_s) / span_s : 1.0;
+  return (1.0 - w) * before->omega_body_radps + w * after->omega_body_radps;
+}
+
 /// The residual r(tau) of every pair of poses in a chain at the lags of kLags, with the gyro's
-/// readings `gyro` (in.gyro corrected, bias removed).
-std::vector<Sample> residuals(const GyroNoiseInput& in, const std::vector<GyroReading>& gyro) {
+/// readings `gyro` (in.gyro corrected, bias removed) and `offset_s` added to the poses' times.
+std::vector<Sample> residuals(const GyroNoiseInput& in, const std::vector<GyroReading>& gyro,
+                              double offset_s) {
   const Eigen::Matrix3d R_c = in.R_correction.matrix();
   std::vector<Sample> samples;
   for (const std::vector<StampedPose>& chain : in.chains) {
     // The poses the gyro covers, and the gyro's rotation from the first of them to each.
     std::vector<const StampedPose*> poses;
     for (const StampedPose& p : chain)
-      if (p.t_s + in.offset_s >= gyro.front().t_s && p.t_s + in.offset_s <= gyro.back().t_s)
+      if (p.t_s + offset_s >= gyro.front().t_s && p.t_s + offset_s <= gyro.back().t_s)
         poses.push_back(&p);
     std::vector<lie::SO3> R_gyro(poses.size());
     for (std::size_t i = 1; i < poses.size(); ++i)
-      R_gyro[i] = R_gyro[i - 1] * integrateGyro(gyro, poses[i - 1]->t_s + in.offset_s,
-                                                poses[i]->t_s + in.offset_s, Vector3d::Zero());
+      R_gyro[i] = R_gyro[i - 1] * integrateGyro(gyro, poses[i - 1]->t_s + offset_s,
+                                                poses[i]->t_s + offset_s, Vector3d::Zero());
     for (std::size_t l = 0; l < kLags.size(); ++l)
       for (std::size_t i = 0; i + kLags[l] < poses.size(); ++i) {
         const std::size_t j = i + kLags[l];
@@ -53,8 +67,13 @@ std::vector<Sample> residuals(const GyroNoiseInput& in, const std::vector<GyroRe
             (poses[i]->pose.rotation().inverse() * poses[j]->pose.rotation()).matrix();
         const lie::SO3 dR_gyro = R_gyro[i].inverse() * R_gyro[j];
         const lie::SO3 dR_reg_in_gyro = lie::SO3::fromMatrix(R_c * dR_reg * R_c.transpose());
-        samples.push_back({static_cast<int>(l), poses[i]->t_s, poses[j]->t_s - poses[i]->t_s,
-                           (dR_reg_in_gyro.inverse() * dR_gyro).Log(), dR_reg_in_gyro.Log()});
+        samples.push_back({.lag_index = static_cast<int>(l),
+                           .t_s = poses[i]->t_s,
+                           .tau_s = poses[j]->t_s - poses[i]->t_s,
+                           .r_rad = (dR_reg_in_gyro.inverse() * dR_gyro).Log(),
+                           .theta_rad = dR_reg_in_gyro.Log(),
+                           .rate_change_radps = rateAt(gyro, poses[j]->t_s + offset_s) -
+                                                rateAt(gyro, poses[i]->t_s + offset_s)});
       }
   }
   return samples;
@@ -90,45 +109,68 @@ std::vector<LagVariance> lagVariances(const std::vector<Sample>& samples, int sk
   return lags;
 }
 
-/// The part of the residuals proportional to the rotation, r ~ A theta (to first order): the
-/// gyro's scale-factor and axis errors (0.5-1.5 % on MEMS gyros, i.e. 2-6 mrad/s in a
-/// handheld's 0.4 rad/s of sway) and any scale error of the registrations' rotations. Left in,
-/// they grow with the lag like noise and read as 2-4x the true density on simulated rigs. A is
-/// fitted by least squares weighted with each lag's variance, samples beyond 5 robust sigmas of
-/// their lag excluded. The registrations' noise is in theta as well as in r (errors in
-/// variables), which pulls A towards -1 in a direction the motion hardly turned about (a machine
-/// that only slews); each sample's noise adds at most I to the information sum theta theta^T / v
-/// (a per-axis noise of theta below v), so only the information's eigen-directions above 100
-/// times the sample count are fitted (a pull of under 1 %), A = 0 in the others.
-Eigen::Matrix3d fitRotationProportional(const std::vector<Sample>& samples,
-                                        const std::vector<LagVariance>& lags) {
+/// The residuals' parts explained, to first order, by errors proportional to the rotation and to
+/// the change of the rate over the lag:
+///   r ~ A theta + B (omega(t_end) - omega(t_start))
+/// A is the gyro's scale-factor and axis errors (omega_measured = (I + A) omega; 0.5-1.5 % on
+/// MEMS gyros, 2-6 mrad/s in a handheld's 0.4 rad/s of sway) and any scale error of the
+/// registrations' rotations. B is what follows the rate at the scans' ends: a time offset the
+/// rotation calibration left (B = -dt I; it fits no scale errors, and a drifting clock's offset is
+/// only right on average), and the deskew errors those scale errors cause in each scan. Left in,
+/// both grow with the lag like noise: with 1.5 % scale errors the density read 2x too high.
+/// Weighted least squares (each lag's variance), samples beyond 5 robust sigmas of their lag
+/// excluded. The registrations' noise is in theta as well as in r (errors in variables), which
+/// pulls A towards -1 in a direction the motion hardly turned about (a machine that only slews);
+/// each sample's noise adds at most about one to the normal equations' diagonal, so only their
+/// eigen-directions above 100 times the sample count are fitted (a pull of under 1 %).
+struct RateError {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+  Vector3d of(const Sample& s) const { return A * s.theta_rad + B * s.rate_change_radps; }
+};
+
+RateError fitRateError(const std::vector<Sample>& samples, const std::vector<LagVariance>& lags) {
   std::array<double, kLags.size()> variance{};
   for (const LagVariance& l : lags)
     for (std::size_t i = 0; i < kLags.size(); ++i)
       if (kLags[i] == l.lag_scans) variance[i] = l.variance_rad2;
-  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  constexpr int kN = 18;  // A and B, column by column
+  using Params = Eigen::Matrix<double, kN, 1>;
+  auto jacobian = [](const Sample& s) {
+    Eigen::Matrix<double, 3, kN> J;
+    for (int c = 0; c < 3; ++c) {
+      J.block<3, 3>(0, 3 * c) = s.theta_rad(c) * Eigen::Matrix3d::Identity();
+      J.block<3, 3>(0, 9 + 3 * c) = s.rate_change_radps(c) * Eigen::Matrix3d::Identity();
+    }
+    return J;
+  };
+  Params p = Params::Zero();
   for (int round = 0; round < 2; ++round) {
-    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();  // sum w theta theta^T
-    Eigen::Matrix3d b = Eigen::Matrix3d::Zero();  // sum w theta r^T
+    Eigen::Matrix<double, kN, kN> H = Eigen::Matrix<double, kN, kN>::Zero();
+    Params g = Params::Zero();
     double count = 0.0;
     for (const Sample& s : samples) {
       const double v = variance[s.lag_index];
       if (v <= 0.0) continue;
-      if (round > 0 && (s.r_rad - A * s.theta_rad).cwiseAbs().maxCoeff() > 5.0 * std::sqrt(v))
-        continue;
-      H += s.theta_rad * s.theta_rad.transpose() / v;
-      b += s.theta_rad * s.r_rad.transpose() / v;
+      const Eigen::Matrix<double, 3, kN> J = jacobian(s);
+      if (round > 0 && (s.r_rad - J * p).cwiseAbs().maxCoeff() > 5.0 * std::sqrt(v)) continue;
+      H += J.transpose() * J / v;
+      g += J.transpose() * s.r_rad / v;
       count += 1.0;
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(H);
-    Eigen::Matrix3d H_pinv = Eigen::Matrix3d::Zero();
-    for (int i = 0; i < 3; ++i)
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kN, kN>> eigen(H);
+    p.setZero();
+    for (int i = 0; i < kN; ++i)
       if (eigen.eigenvalues()(i) > 100.0 * count)
-        H_pinv += eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose() /
-                  eigen.eigenvalues()(i);
-    A = (H_pinv * b).transpose();
+        p += eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).dot(g) /
+             eigen.eigenvalues()(i);
   }
-  return A;
+  RateError e;
+  for (int c = 0; c < 3; ++c) {
+    e.A.col(c) = p.segment<3>(3 * c);
+    e.B.col(c) = p.segment<3>(9 + 3 * c);
+  }
+  return e;
 }
 
 /// The readings with the bias removed and the rate error M undone: M^-1 (omega - b).
@@ -139,17 +181,23 @@ std::vector<GyroReading> corrected(const GyroNoiseInput& in, const Eigen::Matrix
   return gyro;
 }
 
-/// The residuals once the gyro's rate error M (omega_measured = M omega) is found and undone:
-/// A is fitted to first order and folded into M, three times, so that the large rotations of
-/// the longest lags, where first order is not enough, end up with no rate error left.
-std::vector<Sample> residualsWithoutRateError(const GyroNoiseInput& in, Eigen::Matrix3d& M) {
+/// The residuals once the rate errors are found and taken out: A is folded into the readings'
+/// M (omega_measured = M omega) three times, so that the large rotations of the longest lags,
+/// where first order is not enough, end up with none left; B, which is not the gyro's, is
+/// subtracted from the last residuals.
+std::vector<Sample> residualsWithoutRateError(const GyroNoiseInput& in, Eigen::Matrix3d& M,
+                                              Eigen::Matrix3d& B) {
   M = Eigen::Matrix3d::Identity();
-  std::vector<Sample> samples = residuals(in, corrected(in, M));
+  std::vector<Sample> samples = residuals(in, corrected(in, M), in.offset_s);
   for (int round = 0; round < 3; ++round) {
-    const std::vector<LagVariance> lags = lagVariances(samples, -1, {});
-    M = M * (Eigen::Matrix3d::Identity() + fitRotationProportional(samples, lags));
-    samples = residuals(in, corrected(in, M));
+    const RateError step = fitRateError(samples, lagVariances(samples, -1, {}));
+    M = M * (Eigen::Matrix3d::Identity() + step.A);
+    samples = residuals(in, corrected(in, M), in.offset_s);
   }
+  const RateError last = fitRateError(samples, lagVariances(samples, -1, {}));
+  for (Sample& s : samples) s.r_rad -= last.of(s);
+  M = M * (Eigen::Matrix3d::Identity() + last.A);
+  B = last.B;
   return samples;
 }
 
@@ -223,8 +271,8 @@ std::string scientific(double v) { return fmt::format("{:.2g}", v); }
 
 GyroNoiseEstimate estimateGyroNoise(const GyroNoiseInput& input) {
   if (input.gyro.empty()) throw InputError("no gyro readings");
-  Eigen::Matrix3d M;
-  const std::vector<Sample> samples = residualsWithoutRateError(input, M);
+  Eigen::Matrix3d M, B;
+  const std::vector<Sample> samples = residualsWithoutRateError(input, M, B);
   std::vector<LagVariance> lags = lagVariances(samples, -1, {});
   if (lags.size() < kMinLags)
     throw InputError(fmt::format(
@@ -260,6 +308,7 @@ GyroNoiseEstimate estimateGyroNoise(const GyroNoiseInput& input) {
   e.density_sigma = std::max(densitySigma(fit), jackknife_sigma);
   e.rate_error_radps = std::sqrt(fit.p(2));
   e.rate_error_matrix = M - Eigen::Matrix3d::Identity();
+  e.rate_change_matrix_s = B;
   e.registration_sigma_rad = std::sqrt(fit.p(0) / 2.0);
   for (LagVariance& l : lags)
     l.model_rad2 = fit.p(0) + fit.p(1) * l.tau_s + fit.p(2) * l.tau_s * l.tau_s;

@@ -254,6 +254,16 @@ const Field<RigErrorParams> kRigFields[] = {
     {"lidar_clock_drift_ppm", &RigErrorParams::lidar_clock_drift_ppm, "lidar clock rate error, ppm", -1000, 1000},
 };
 
+const Field<FaultParams> kFaultFields[] = {
+    {"imu_gap_start_s", &FaultParams::imu_gap_start_s, "no IMU samples from here, s", 0, 86400},
+    {"imu_gap_s", &FaultParams::imu_gap_s, "for this long (0: no gap), s", 0, 86400},
+    {"packet_burst_start_s", &FaultParams::packet_burst_start_s, "scans from here lose packets, s", 0, 86400},
+    {"packet_burst_scans", &FaultParams::packet_burst_scans, "this many scans (0: none)", 0, 1000000},
+    {"packet_burst_loss", &FaultParams::packet_burst_loss, "share of their 16-column packets lost", 0, 1},
+    {"splice_at_s", &FaultParams::splice_at_s, "the scan starting here is replaced (0: none), s", 0, 86400},
+    {"splice_from_s", &FaultParams::splice_from_s, "by the scan simulated at this time, s", 0, 86400},
+};
+
 const Field<OutputParams> kOutputFields[] = {
     {"scan_stride", &OutputParams::scan_stride, "keep every n-th scan", 1, 1000},
     {"imu", &OutputParams::imu, "write the IMU topic"},
@@ -286,7 +296,8 @@ class ScenarioSection final : public TableSection<Scenario> {
         imu_(s.imu, kImuFields),
         gnss_(s.gnss, kGnssFields),
         rig_(s.rig, kRigFields),
-        output_(s.output) {}
+        output_(s.output),
+        faults_(s.faults, kFaultFields) {}
 
  private:
   void visit(ConfigVisitor& v) override {
@@ -307,6 +318,7 @@ class ScenarioSection final : public TableSection<Scenario> {
     v.section("gnss", gnss_, "the GNSS receiver and the world frame's georeference");
     v.section("rig", rig_, "how the true rig differs from its rig.yaml");
     v.section("output", output_, "what the recording holds");
+    v.section("faults", faults_, "faults injected into the recording (all off by default)");
   }
   ForestSection forest_;
   MotionSection motion_;
@@ -315,6 +327,7 @@ class ScenarioSection final : public TableSection<Scenario> {
   TableSection<GnssParams> gnss_;
   TableSection<RigErrorParams> rig_;
   OutputSection output_;
+  TableSection<FaultParams> faults_;
 };
 
 }  // namespace

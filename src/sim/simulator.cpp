@@ -11,6 +11,7 @@
 #include "taiga/core/trajectory.hpp"
 #include "taiga/io/rosbag.hpp"
 #include "taiga/io/trajectory_io.hpp"
+#include "taiga/sim/random.hpp"
 
 namespace taiga::sim {
 namespace {
@@ -48,6 +49,45 @@ void deskewWithTruth(io::Scan& scan, const WalkingMotion& motion, const lie::SE3
   cloud.times_s.clear();
   cloud.rings.clear();
   cloud.columns.clear();
+}
+
+/// faults.packet_burst_*: the burst's scans lose that share of their 16-column packets (as
+/// LidarSimulator's own packet loss, on the finished cloud).
+void dropPacketsOfBurst(io::Scan& scan, const FaultParams& f, double t_start_s, double period_s,
+                        std::uint64_t seed) {
+  const double end_s = f.packet_burst_start_s + f.packet_burst_scans * period_s;
+  if (f.packet_burst_scans == 0 || t_start_s < f.packet_burst_start_s - 1e-9 ||
+      t_start_s >= end_s - 1e-9)
+    return;
+  PointCloud& cloud = scan.cloud_in_lidar;
+  std::vector<std::size_t> kept;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::uint64_t packet = cloud.columns[i] / 16;
+    if (hashUniform(seed, scan.index, packet, 105) >= f.packet_burst_loss) kept.push_back(i);
+  }
+  cloud = cloud.select(kept);
+}
+
+/// faults.splice_*: the scan at motion time t_start_s replaced by the one simulated at
+/// splice_from_s (another place), stamped as the one it replaces.
+io::Scan splicedScan(const Simulation& sim, std::uint64_t index, double t_start_s,
+                     double lidar_clock_s) {
+  const LidarSimulator& lidar = sim.lidar();
+  const FaultParams& f = sim.scenario().faults;
+  const auto from = static_cast<std::uint64_t>(std::llround(f.splice_from_s / lidar.scanPeriod_s()));
+  const double t_from_s = static_cast<double>(from) * lidar.scanPeriod_s();
+  const double clock_from_s = lidarClockOffset_s(sim.scenario().rig, t_from_s);
+  io::Scan scan = lidar.simulateScan(sim.scene(), sim.motion(), from, t_from_s, clock_from_s);
+  const double shift_s = (t_start_s + lidar_clock_s) - (t_from_s + clock_from_s);
+  scan.index = index;
+  scan.t_start_s += shift_s;
+  scan.t_end_s += shift_s;
+  for (double& t : scan.cloud_in_lidar.times_s) t += shift_s;
+  return scan;
+}
+
+bool isSplicedScan(const FaultParams& f, double t_start_s, double period_s) {
+  return f.splice_at_s > 0.0 && std::abs(t_start_s - f.splice_at_s) < 0.5 * period_s;
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
@@ -99,7 +139,9 @@ SimulationSummary writeSimulation(const Simulation& simulation,
     while (imu.nextTime_s() <= t_end_s) {
       const double t = imu.nextTime_s();
       const ImuSample sample = imu.next(motion, kRecordingEpoch_s);
-      if (scenario.output.imu) {
+      const FaultParams& f = scenario.faults;  // a gap: the sample is drawn, not written
+      const bool gap = t >= f.imu_gap_start_s && t < f.imu_gap_start_s + f.imu_gap_s;
+      if (scenario.output.imu && !gap) {
         bag.writeImu(kImuTopic, "os_imu", sample);
         ++summary.imu_samples;
       }
@@ -129,7 +171,10 @@ SimulationSummary writeSimulation(const Simulation& simulation,
     }
     const double t_start = static_cast<double>(k) * lidar.scanPeriod_s();
     const double lidar_clock_s = lidarClockOffset_s(scenario.rig, t_start);
-    io::Scan scan = lidar.simulateScan(scene, motion, k, t_start, lidar_clock_s);
+    io::Scan scan = isSplicedScan(scenario.faults, t_start, lidar.scanPeriod_s())
+                        ? splicedScan(simulation, k, t_start, lidar_clock_s)
+                        : lidar.simulateScan(scene, motion, k, t_start, lidar_clock_s);
+    dropPacketsOfBurst(scan, scenario.faults, t_start, lidar.scanPeriod_s(), simulation.seed());
     const double t_end = scan.t_end_s - lidar_clock_s;  // motion time: the scan is complete
     emitUntil(t_end);
     if (output.point_layout == "velodyne") {

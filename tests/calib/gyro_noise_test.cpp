@@ -34,6 +34,7 @@ struct Rig {
   Eigen::Matrix3d M = Eigen::Matrix3d::Identity();  ///< scale and axis errors
   double duration_s = 30.0;
   Vector3d amplitude = kHandheld;
+  double gyro_late_s = 0.0;  ///< the gyro's stamps are this late against the poses'
 };
 
 GyroNoiseInput simulate(const Rig& rig, unsigned seed) {
@@ -48,7 +49,8 @@ GyroNoiseInput simulate(const Rig& rig, unsigned seed) {
   const Vector3d bias(1e-3, -2e-3, 5e-4);
   in.bias_radps = bias;
   for (double t = 0.0; t <= rig.duration_s + 1.0; t += 1.0 / kRate_hz)
-    in.gyro.push_back({t, rig.M * omegaBody(rig.amplitude, t) + bias + noise3(reading_sigma)});
+    in.gyro.push_back({t + rig.gyro_late_s,
+                       rig.M * omegaBody(rig.amplitude, t) + bias + noise3(reading_sigma)});
   in.chains.emplace_back();
   for (double t = 0.5; t < rig.duration_s; t += 0.1) {
     if (std::fmod(t, 9.0) < 0.1) in.chains.emplace_back();  // a scan not registered now and then
@@ -70,16 +72,19 @@ TEST(GyroNoise, MeasuresTheDensityBesideTheRegistrationsNoise) {
     }
 }
 
-TEST(GyroNoise, ScaleAndAxisErrorsAreNotTakenForNoise) {
-  // 1 % scale errors and 0.6 deg misalignments: 4 mrad/s in this sway, 16 times the noise. Left
-  // in, they would read as several times the density.
+TEST(GyroNoise, ScaleAxisAndTimeErrorsAreNotTakenForNoise) {
+  // 1 % scale errors and 0.6 deg misalignments: 4 mrad/s in this sway, 16 times the noise; and
+  // 1.5 ms of time offset left over. Left in, they would read as several times the density.
   Eigen::Matrix3d M;
   M << 1.01, 0.01, -0.004, 0.006, 0.99, 0.01, -0.01, 0.003, 1.012;
   for (unsigned seed : {1u, 2u}) {
-    const GyroNoiseEstimate e = estimateGyroNoise(simulate({.density = 2.5e-4, .M = M}, seed));
+    const GyroNoiseEstimate e =
+        estimateGyroNoise(simulate({.density = 2.5e-4, .M = M, .gyro_late_s = 0.0015}, seed));
     EXPECT_NEAR(e.density_radps_sqrthz, 2.5e-4, 0.15 * 2.5e-4) << "seed " << seed;
     EXPECT_LT((e.rate_error_matrix - (M - Eigen::Matrix3d::Identity())).norm(), 2e-3)
         << e.rate_error_matrix;
+    // The offset left over is B's diagonal, B = -dt I (its other terms trade with A's in a sway).
+    EXPECT_NEAR(-e.rate_change_matrix_s.trace() / 3.0, 0.0015, 0.0003) << e.rate_change_matrix_s;
   }
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../support/temp_dir.hpp"
+#include "simulate_and_read.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
 #include "taiga/io/recording.hpp"
@@ -15,28 +16,6 @@
 
 namespace taiga::sim {
 namespace {
-
-struct Written {
-  SystemConfig rig;
-  std::vector<io::Scan> scans;
-  std::size_t imu_samples = 0;
-};
-
-Written simulateAndRead(const std::string& overrides, const test::TempDir& dir, double duration_s,
-                        Scenario* scenario_out = nullptr) {
-  Scenario s = scenarioByName("mixed");
-  applyScenarioOverridesText(overrides, "test.yaml", s);
-  writeSimulation(Simulation(s, duration_s, 6), dir.path());
-  if (scenario_out) *scenario_out = s;
-  Written w;
-  io::readConfigYaml(dir.file("rig.yaml"), w.rig);
-  io::Recording recording = io::openRecording(dir.file("recording.bag"), w.rig.recording, w.rig.rig);
-  while (auto event = recording.next()) {
-    if (auto* scan = std::get_if<io::Scan>(&*event)) w.scans.push_back(std::move(*scan));
-    if (std::holds_alternative<ImuSample>(*event)) ++w.imu_samples;
-  }
-  return w;
-}
 
 /// Median distance of the scan's points to the true scene when each point is placed with
 /// `T_world_lidar(point time)`.

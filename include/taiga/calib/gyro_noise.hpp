@@ -55,6 +55,10 @@ struct GyroNoiseEstimate {
   /// diagonal the scale-factor errors (0.005 for 0.5 %), the rest axis misalignment (a rotation
   /// of the lidar is in R_c, not here). It also holds any scale error of the registrations.
   Eigen::Matrix3d rate_error_matrix = Eigen::Matrix3d::Zero();
+  /// The residual's part that follows the rate's change over the lag, r ~ B (omega(t_end) -
+  /// omega(t_start)), taken out before (1) too: a time offset the rotation calibration left
+  /// (B = -dt I) and the deskew errors of a gyro's scale errors, s.
+  Eigen::Matrix3d rate_change_matrix_s = Eigen::Matrix3d::Zero();
   std::vector<LagVariance> lags;
 };
 

@@ -204,6 +204,21 @@ struct OutputParams {
   bool gnss = true;     ///< write the GNSS topic
 };
 
+/// Faults injected into the recording, to test that a run says what went wrong (the
+/// no-silent-failure issue; docs/simulator.md, "Faults"). Each is off at its default. Times are
+/// the motion's, s after the recording's start.
+struct FaultParams {
+  double imu_gap_start_s = 0.0;  ///< no IMU samples from here ...
+  double imu_gap_s = 0.0;        ///< ... for this long (0: no gap)
+  double packet_burst_start_s = 0.0;  ///< the scans from here ...
+  int packet_burst_scans = 0;         ///< ... this many of them (0: none) ...
+  double packet_burst_loss = 0.9;     ///< ... lose this share of their 16-column packets
+  /// The scan that starts here (0: none) is replaced by the one simulated at splice_from_s, from
+  /// another place, stamped as the scan it replaces.
+  double splice_at_s = 0.0;
+  double splice_from_s = 0.0;
+};
+
 struct Scenario {
   std::string name = "mixed";
   /// The realism preset the errors came from (`ideal`, `typical`, `harsh`; realism.hpp); the
@@ -217,6 +232,7 @@ struct Scenario {
   GnssParams gnss;
   RigErrorParams rig;
   OutputParams output;
+  FaultParams faults;
 };
 
 /// The scenarios `taiga simulate --scenario` knows (canonical names).
