@@ -1,4 +1,5 @@
 #include "taiga/backend/gnss_factor.hpp"
+#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
 #include <cmath>
@@ -32,7 +33,7 @@ GnssFactor::GnssFactor(const Eigen::Vector3d& d_body, const Eigen::Vector3d& p_e
     : d_body_(d_body),
       p_enu_(p_enu),
       sqrt_information_(
-          Eigen::LLT<Eigen::Matrix3d>(covariance_enu_m2.inverse()).matrixL().transpose()) {}
+          sqrtInformation<3>(covariance_enu_m2)) {}
 
 bool GnssFactor::Evaluate(double const* const* parameters, double* residuals,
                           double** jacobians) const {

@@ -1,4 +1,5 @@
 #include "taiga/backend/imu_factor.hpp"
+#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -34,7 +35,7 @@ ImuFactor::ImuFactor(imu::Preintegrator preintegrated, const Eigen::Vector3d& gr
       Matrix3::Identity() * noise.accel_bias_random_walk * noise.accel_bias_random_walk * dt;
   covariance_.block<3, 3>(12, 12) =
       Matrix3::Identity() * noise.gyro_bias_random_walk * noise.gyro_bias_random_walk * dt;
-  sqrt_information_ = Eigen::LLT<Matrix15>(covariance_.inverse()).matrixL().transpose();
+  sqrt_information_ = sqrtInformation<15>(covariance_);
 }
 
 Vector15 ImuFactor::rawResidual(const StateBlocks& i, const StateBlocks& j) const {

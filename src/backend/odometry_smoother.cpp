@@ -5,11 +5,14 @@
 #include <ceres/solver.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
 #include "taiga/backend/pose_factor.hpp"
 #include "taiga/backend/state_prior.hpp"
+#include "taiga/core/log.hpp"
 
 namespace taiga::backend {
 
@@ -58,6 +61,16 @@ void linearize(ceres::Problem& problem, const std::vector<double*>& blocks, Eige
                                             static_cast<Eigen::Index>(residuals.size()));
   H = J.transpose() * J;
   b = J.transpose() * r;
+}
+
+/// A prior that holds a state without constraining it much: 1 m, 0.1 rad, 1 m/s, 0.1 m/s^2,
+/// 0.01 rad/s (1-sigma), in the tangent order [dp; dtheta; dv; dba; dbg].
+Matrix15 weakCovariance() {
+  Eigen::Matrix<double, 15, 1> sigma;
+  sigma << Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(0.1),
+      Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(0.1),
+      Eigen::Vector3d::Constant(0.01);
+  return sigma.cwiseAbs2().asDiagonal();
 }
 
 /// x (+) delta in the tangent order [dp; dtheta; dv; dba; dbg].
@@ -136,12 +149,17 @@ void OdometrySmoother::optimize() {
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
   linearize(problem, blocks, H, b);
-  const Eigen::Index n = H.rows();
-  const Eigen::MatrixXd covariance = H.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
   const Node& newest = *window_.back();
   latest_.t_s = newest.t_s;
   latest_.state = newest.blocks.navState();
   latest_.bias = newest.blocks.bias();
+  const Eigen::Index n = H.rows();
+  if (n < 15 || !H.allFinite()) {  // not evaluable: the covariance is unknown, not garbage
+    ++numerical_failures_;
+    latest_.covariance = weakCovariance();
+    return;
+  }
+  const Eigen::MatrixXd covariance = H.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
   latest_.covariance = covariance.bottomRightCorner<15, 15>();
 }
 
@@ -168,16 +186,34 @@ void OdometrySmoother::marginalizeOldest() {
             H, b);
   // Schur complement onto the next state: H' = H11 - H10 H00^-1 H01, b' = b1 - H10 H00^-1 b0.
   const Eigen::LDLT<Eigen::MatrixXd> H00(H.topLeftCorner(15, 15));
-  const Matrix15 H_marginal = H.bottomRightCorner(15, 15) -
-                              H.bottomLeftCorner(15, 15) * H00.solve(H.topRightCorner(15, 15));
+  Matrix15 H_marginal = H.bottomRightCorner(15, 15) -
+                        H.bottomLeftCorner(15, 15) * H00.solve(H.topRightCorner(15, 15));
   const Eigen::Matrix<double, 15, 1> b_marginal =
       b.tail(15) - H.bottomLeftCorner(15, 15) * H00.solve(b.head(15));
-  // The quadratic 1/2 d^T H' d + b'^T d is a Gaussian with mean next (+) (-H'^-1 b').
-  const Eigen::LDLT<Matrix15> H_marginal_ldlt(H_marginal);
-  const Eigen::Matrix<double, 15, 1> shift = -H_marginal_ldlt.solve(b_marginal);
-  Matrix15 covariance = H_marginal_ldlt.solve(Matrix15::Identity());
-  covariance = 0.5 * (covariance + covariance.transpose());
-  next.prior = std::make_unique<StatePrior>(plus(next.blocks, shift), covariance);
+  if (H.rows() != 30 || !H_marginal.allFinite() || !b_marginal.allFinite()) {
+    // The factors could not be evaluated (a non-finite IMU factor, e.g. across a long gap in
+    // the readings): the next state keeps a weak prior at its estimate instead of a broken one.
+    ++numerical_failures_;
+    logger().warn("odometry smoother: the marginalized state's factors were not finite at {:.3f} s; "
+                  "the window keeps a weak prior instead",
+                  next.t_s);
+    next.prior = std::make_unique<StatePrior>(next.blocks, weakCovariance());
+  } else {
+    // The quadratic 1/2 d^T H' d + b'^T d is a Gaussian with mean next (+) (-H'^-1 b'). H' is
+    // made symmetric and its eigenvalues floored at 1e-12 of the largest: when a direction lost
+    // nearly all its information (a gap in the IMU readings, no lidar), the covariance would
+    // otherwise span more than double precision and its inverse in StatePrior fail.
+    H_marginal = 0.5 * (H_marginal + H_marginal.transpose());
+    const Eigen::SelfAdjointEigenSolver<Matrix15> eigen(H_marginal);
+    const double floor = 1e-12 * std::max(eigen.eigenvalues().maxCoeff(), 1e-300);
+    const Eigen::Matrix<double, 15, 1> lambda = eigen.eigenvalues().cwiseMax(floor);
+    const Matrix15& V = eigen.eigenvectors();
+    const Eigen::Matrix<double, 15, 1> shift =
+        -V * lambda.cwiseInverse().asDiagonal() * V.transpose() * b_marginal;
+    Matrix15 covariance = V * lambda.cwiseInverse().asDiagonal() * V.transpose();
+    covariance = 0.5 * (covariance + covariance.transpose());
+    next.prior = std::make_unique<StatePrior>(plus(next.blocks, shift), covariance);
+  }
   next.imu_from_previous.reset();
   window_.pop_front();
 }

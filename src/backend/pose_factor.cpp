@@ -1,4 +1,5 @@
 #include "taiga/backend/pose_factor.hpp"
+#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -6,7 +7,7 @@ namespace taiga::backend {
 
 PoseFactor::PoseFactor(const lie::SE3& T_world_body_measured, const lie::Matrix6& covariance)
     : T_measured_world_(T_world_body_measured.inverse()),
-      sqrt_information_(Eigen::LLT<lie::Matrix6>(covariance.inverse()).matrixL().transpose()) {}
+      sqrt_information_(sqrtInformation<6>(covariance)) {}
 
 bool PoseFactor::Evaluate(double const* const* parameters, double* residuals,
                           double** jacobians) const {

@@ -1,4 +1,5 @@
 #include "taiga/backend/position_factor.hpp"
+#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -8,7 +9,7 @@ PositionFactor::PositionFactor(const Eigen::Vector3d& p_world_measured,
                                const Eigen::Matrix3d& covariance)
     : p_world_measured_(p_world_measured),
       sqrt_information_(
-          Eigen::LLT<Eigen::Matrix3d>(covariance.inverse()).matrixL().transpose()) {}
+          sqrtInformation<3>(covariance)) {}
 
 bool PositionFactor::Evaluate(double const* const* parameters, double* residuals,
                               double** jacobians) const {

@@ -1,4 +1,5 @@
 #include "taiga/backend/relative_pose_factor.hpp"
+#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -7,7 +8,7 @@ namespace taiga::backend {
 RelativePoseFactor::RelativePoseFactor(const lie::SE3& T_i_j_measured,
                                        const lie::Matrix6& covariance)
     : T_j_i_measured_(T_i_j_measured.inverse()),
-      sqrt_information_(Eigen::LLT<lie::Matrix6>(covariance.inverse()).matrixL().transpose()) {}
+      sqrt_information_(sqrtInformation<6>(covariance)) {}
 
 lie::Vector6 RelativePoseFactor::error(const lie::SE3& T_world_i, const lie::SE3& T_world_j) const {
   return (T_j_i_measured_ * (T_world_i.inverse() * T_world_j)).Log();

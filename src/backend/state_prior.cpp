@@ -1,4 +1,5 @@
 #include "taiga/backend/state_prior.hpp"
+#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -6,7 +7,7 @@ namespace taiga::backend {
 
 StatePrior::StatePrior(const StateBlocks& mean, const Matrix15& covariance)
     : mean_(mean),
-      sqrt_information_(Eigen::LLT<Matrix15>(covariance.inverse()).matrixL().transpose()) {}
+      sqrt_information_(sqrtInformation<15>(covariance)) {}
 
 bool StatePrior::Evaluate(double const* const* parameters, double* residuals,
                           double** jacobians) const {

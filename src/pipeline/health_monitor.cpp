@@ -71,6 +71,8 @@ std::string HealthMonitor::limitProblems(const HealthEvidence& scan, bool& impos
       append(reasons,
              fmt::format("gyroscope bias estimate {:.1f} deg/s is implausible", gyro_bias_dps));
   }
+  if (scan.imu_gap_s > config_.max_imu_gap_s)
+    append(reasons, fmt::format("no IMU readings for {:.2f} s", scan.imu_gap_s));
   if (scan.registered && scan.lidar == LidarFactor::kRejected)
     append(reasons, "lidar factor rejected: " + scan.lidar_note);
   if (scan.registered && scan.lidar == LidarFactor::kInflated) append(reasons, scan.lidar_note);

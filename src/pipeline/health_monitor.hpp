@@ -28,6 +28,7 @@ struct HealthEvidence {
   Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();
   imu::ImuBias bias;
   bool estimates_bias = false;
+  double imu_gap_s = 0.0;  ///< the longest stretch without IMU readings before the scan, s
 };
 
 class HealthMonitor {

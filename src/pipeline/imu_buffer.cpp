@@ -48,6 +48,17 @@ imu::Preintegrator ImuBuffer::preintegrate(double t_from_s, double t_to_s,
   return imu::preintegrateReadings(samples_, t_from_s, t_to_s, bias_hat, noise);
 }
 
+double ImuBuffer::longestGap(double t_from_s, double t_to_s) const {
+  double previous_s = t_from_s, longest_s = 0.0;
+  for (std::size_t i = inForce(samples_, t_from_s); i < samples_.size(); ++i) {
+    const double t_s = std::clamp(samples_[i].t_s, t_from_s, t_to_s);
+    longest_s = std::max(longest_s, t_s - previous_s);
+    previous_s = std::max(previous_s, t_s);
+    if (samples_[i].t_s >= t_to_s) return longest_s;
+  }
+  return std::max(longest_s, t_to_s - previous_s);
+}
+
 void ImuBuffer::dropBefore(double t_s) {
   const std::size_t keep_from = inForce(samples_, t_s);
   samples_.erase(samples_.begin(), samples_.begin() + static_cast<std::ptrdiff_t>(keep_from));

@@ -11,6 +11,10 @@ namespace {
 
 /// IMU readings needed before the first scan is used, s.
 constexpr double kInitializationWindow_s = 0.5;
+/// The IMU noise over a stretch without readings: 1-sigma 3 m/s and 0.3 rad over a second, an
+/// IMU factor that leaves the lidar to place the body (tens of times weaker than its 1 cm).
+constexpr double kGapAccelNoise = 3.0;  // m/s^2/sqrt(Hz)
+constexpr double kGapGyroNoise = 0.3;   // rad/s/sqrt(Hz)
 
 }  // namespace
 
@@ -73,9 +77,29 @@ std::optional<double> ImuPrior::stateTime() const {
 MotionPrediction ImuPrior::predict(const io::Scan& scan) {
   const backend::StateEstimate previous = smoother_.latest();
   MotionPrediction prediction;
+  // Across a gap in the readings (odometry.health.max_imu_gap_s) the preintegration only holds or
+  // interpolates the readings around it, and a handheld's sway changes its rate within a tenth of
+  // a second: the scan is predicted and deskewed with the twist of the last two states instead,
+  // the preintegration's noise is raised to what it can still tell (a weak IMU factor), and the
+  // lidar carries the state through. Holding the last reading instead lost a walk within 0.5 s.
+  prediction.imu_gap_s = imu_.longestGap(previous.t_s, scan.t_end_s);
+  in_gap_ = prediction.imu_gap_s > config_.health.max_imu_gap_s && state_before_;
+  imu::ImuNoise noise = config_.imu;
+  if (in_gap_) {
+    noise.accel_noise_density = std::max(noise.accel_noise_density, kGapAccelNoise);
+    noise.gyro_noise_density = std::max(noise.gyro_noise_density, kGapGyroNoise);
+  }
   // The preintegrated increment predicts the pose at the scan's end (and is the IMU factor).
-  preintegrated_.emplace(imu_.preintegrate(previous.t_s, scan.t_end_s, previous.bias, config_.imu));
+  preintegrated_.emplace(imu_.preintegrate(previous.t_s, scan.t_end_s, previous.bias, noise));
   predicted_t_s_ = scan.t_end_s;
+  if (in_gap_) {
+    prediction.T_odom_body = constantVelocityAt(scan.t_end_s);
+    constexpr double kStep_s = 0.01;  // poses over the sweep for the deskew's interpolation
+    for (double t = scan.t_start_s; t < scan.t_end_s; t += kStep_s)
+      prediction.sweep_T_odom_body.append(t, constantVelocityAt(t));
+    prediction.sweep_T_odom_body.append(scan.t_end_s, prediction.T_odom_body);
+    return prediction;
+  }
   prediction.T_odom_body =
       poseOf(preintegrated_->predict(previous.state, previous.bias, gravity_odom_));
   // Propagation at IMU rate over the sweep (from its start when it began before the state).
@@ -89,7 +113,18 @@ MotionPrediction ImuPrior::predict(const io::Scan& scan) {
   return prediction;
 }
 
+lie::SE3 ImuPrior::constantVelocityAt(double t_s) const {
+  const backend::StateEstimate& latest = smoother_.latest();
+  const lie::SE3 T_latest = poseOf(latest.state);
+  const double dt_s = latest.t_s - state_before_->t_s;
+  if (!(dt_s > 0.0)) return T_latest;
+  const lie::Vector6 twist_per_s = (state_before_->pose.inverse() * T_latest).Log() / dt_s;
+  return T_latest * lie::SE3::Exp(twist_per_s * (t_s - latest.t_s));
+}
+
 MotionUpdate ImuPrior::update(const std::optional<backend::PoseMeasurement>& lidar) {
+  const backend::StateEstimate before = smoother_.latest();
+  state_before_ = StampedPose{before.t_s, poseOf(before.state)};
   const backend::StateEstimate estimate =
       smoother_.addState(predicted_t_s_, *preintegrated_, lidar);
   imu_.dropBefore(estimate.t_s);
@@ -101,6 +136,7 @@ MotionUpdate ImuPrior::update(const std::optional<backend::PoseMeasurement>& lid
     update.T_odom_unlevelled = collectForAlignment(
         estimate.t_s, lidar ? lidar->T_world_body : update.state.T_odom_body, &*preintegrated_);
     if (update.T_odom_unlevelled) {
+      state_before_.reset();  // in the unlevelled frame
       const backend::StateEstimate levelled = smoother_.latest();
       update.state.T_odom_body = poseOf(levelled.state);
       update.state.v_odom = levelled.state.v_world;

@@ -34,7 +34,8 @@ class ImuPrior final : public MotionPrior {
   bool start(const io::Scan& scan, std::optional<FirstScan>& first) override;
   std::optional<double> stateTime() const override;
   MotionPrediction predict(const io::Scan& scan) override;
-  bool boundsJumps() const override { return true; }
+  /// Not across a gap in the readings, when the prediction is the constant-velocity one.
+  bool boundsJumps() const override { return !in_gap_; }
   MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) override;
   bool levelled() const override { return levelled_; }
   const std::string& initializationNote() const override { return initialization_note_; }
@@ -50,6 +51,8 @@ class ImuPrior final : public MotionPrior {
   /// Levels the frame with the collected poses; returns T_levelled_unlevelled, or none when the
   /// alignment is not trusted (the IMU's attitude is kept).
   std::optional<lie::SE3> levelFrame();
+  /// Across a gap in the readings: the pose at t_s from the twist between the last two states.
+  lie::SE3 constantVelocityAt(double t_s) const;
 
   OdometryConfig config_;
   lie::SO3 R_body_imu_;
@@ -57,6 +60,8 @@ class ImuPrior final : public MotionPrior {
   const registration::RegistrationConfig& registration_;
   Eigen::Vector3d gravity_odom_;
   ImuBuffer imu_;  ///< readings in the body frame
+  std::optional<StampedPose> state_before_;  ///< the state before the latest one
+  bool in_gap_ = false;  ///< the scan last predicted followed a gap in the readings
   backend::OdometrySmoother smoother_;
   std::optional<io::Scan> first_scan_;  ///< held until the second scan arrives
   /// The scan last predicted: its end time and the increment since the previous state.

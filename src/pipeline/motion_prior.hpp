@@ -33,6 +33,10 @@ struct MotionPrediction {
   Trajectory sweep_T_odom_body;  ///< poses covering the sweep, for deskewing
   /// Propagated IMU-rate poses after the previous state up to the scan's end (IMU only).
   std::vector<StampedPose> imu_rate_poses;
+  /// The longest time without an IMU reading from the previous state to the scan's end (IMU
+  /// only), s: beyond odometry.health.max_imu_gap_s the IMU factor over it is weakened and the
+  /// scan degraded.
+  double imu_gap_s = 0.0;
 };
 
 struct MotionState {

@@ -131,6 +131,7 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   // 1. Predict; 2. deskew into the body frame at the scan's end.
   MotionPrediction prediction = motion_->predict(scan);
   outcome.imu_rate_poses = std::move(prediction.imu_rate_poses);
+  outcome.imu_gap_s = prediction.imu_gap_s;
   const PointCloud cloud_in_body = preparation_->deskewedInBody(scan, prediction.sweep_T_odom_body);
   outcome.timing.deskew_ms = msSince(start);
 
@@ -262,7 +263,8 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
                                    .inlier_share = inlierShare(r, outcome.source_points),
                                    .v_odom = outcome.v_odom,
                                    .bias = outcome.bias,
-                                   .estimates_bias = !lidar_only_});
+                                   .estimates_bias = !lidar_only_,
+                                   .imu_gap_s = outcome.imu_gap_s});
   if (health_->restartLocalMap()) {
     // Lost for long: the old local map no longer explains the scans. A new segment starts with
     // this scan, placed by dead reckoning (docs/odometry.md, "Health").

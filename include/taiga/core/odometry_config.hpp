@@ -49,6 +49,9 @@ struct HealthConfig final : ConfigSection {
   /// With an IMU: a median rotation between the IMU's prediction and the registration above this
   /// over the run means the rig's calibration or noise settings are suspect, deg per scan.
   double max_median_innovation_deg = 0.5;
+  /// With an IMU: a stretch without IMU readings longer than this before a scan degrades it, and
+  /// the IMU factor over it is weakened to what the readings around it can tell, s.
+  double max_imu_gap_s = 0.05;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

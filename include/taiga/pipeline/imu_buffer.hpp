@@ -20,6 +20,9 @@ class ImuBuffer {
   bool empty() const { return samples_.empty(); }
   double firstTime() const { return samples_.front().t_s; }
   double lastTime() const { return samples_.back().t_s; }
+  /// The longest time within [t_from_s, t_to_s] without a reading (the stretch after the last
+  /// reading up to t_to_s included): a gap in the IMU stream, s.
+  double longestGap(double t_from_s, double t_to_s) const;
   /// The readings from the one in force at t_from_s (the latest at or before it) up to t_to_s.
   std::vector<ImuSample> between(double t_from_s, double t_to_s) const;
   /// The same and the first reading after t_to_s, when there is one: all that the signal over

@@ -80,6 +80,8 @@ struct ScanOutcome {
   /// How far the registration moved the body from the motion prior's prediction (translation m,
   /// rotation deg); 0 without a registration.
   double innovation_m = 0.0, innovation_deg = 0.0;
+  /// The longest stretch without IMU readings from the previous state to the scan's end, s.
+  double imu_gap_s = 0.0;
   std::size_t source_points = 0;
   ScanHealth health;
   /// The local map segment the scan belongs to: 0, and one more each time the odometry gave up
