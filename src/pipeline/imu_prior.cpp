@@ -83,16 +83,17 @@ MotionPrediction ImuPrior::predict(const io::Scan& scan) {
   // the preintegration's noise is raised to what it can still tell (a weak IMU factor), and the
   // lidar carries the state through. Holding the last reading instead lost a walk within 0.5 s.
   prediction.imu_gap_s = imu_.longestGap(previous.t_s, scan.t_end_s);
-  in_gap_ = prediction.imu_gap_s > config_.health.max_imu_gap_s && state_before_;
+  const bool in_gap = prediction.imu_gap_s > config_.health.max_imu_gap_s && state_before_;
   imu::ImuNoise noise = config_.imu;
-  if (in_gap_) {
+  if (in_gap) {
+    last_gap_end_s_ = scan.t_end_s;
     noise.accel_noise_density = std::max(noise.accel_noise_density, kGapAccelNoise);
     noise.gyro_noise_density = std::max(noise.gyro_noise_density, kGapGyroNoise);
   }
   // The preintegrated increment predicts the pose at the scan's end (and is the IMU factor).
   preintegrated_.emplace(imu_.preintegrate(previous.t_s, scan.t_end_s, previous.bias, noise));
   predicted_t_s_ = scan.t_end_s;
-  if (in_gap_) {
+  if (in_gap) {
     prediction.T_odom_body = constantVelocityAt(scan.t_end_s);
     constexpr double kStep_s = 0.01;  // poses over the sweep for the deskew's interpolation
     for (double t = scan.t_start_s; t < scan.t_end_s; t += kStep_s)

@@ -34,8 +34,10 @@ class ImuPrior final : public MotionPrior {
   bool start(const io::Scan& scan, std::optional<FirstScan>& first) override;
   std::optional<double> stateTime() const override;
   MotionPrediction predict(const io::Scan& scan) override;
-  /// Not across a gap in the readings, when the prediction is the constant-velocity one.
-  bool boundsJumps() const override { return !in_gap_; }
+  /// Not across a gap in the readings, when the prediction is the constant-velocity one, nor
+  /// for a second after it: the state the gap left may be off by degrees, which the lidar must
+  /// be allowed to correct.
+  bool boundsJumps() const override { return !last_gap_end_s_ || predicted_t_s_ > *last_gap_end_s_ + 1.0; }
   MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) override;
   bool levelled() const override { return levelled_; }
   const std::string& initializationNote() const override { return initialization_note_; }
@@ -61,7 +63,7 @@ class ImuPrior final : public MotionPrior {
   Eigen::Vector3d gravity_odom_;
   ImuBuffer imu_;  ///< readings in the body frame
   std::optional<StampedPose> state_before_;  ///< the state before the latest one
-  bool in_gap_ = false;  ///< the scan last predicted followed a gap in the readings
+  std::optional<double> last_gap_end_s_;  ///< the end of the last scan predicted across a gap
   backend::OdometrySmoother smoother_;
   std::optional<io::Scan> first_scan_;  ///< held until the second scan arrives
   /// The scan last predicted: its end time and the increment since the previous state.
