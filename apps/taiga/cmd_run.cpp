@@ -49,6 +49,10 @@ void printHealth(const pipeline::HealthReport& h) {
     fmt::print("           lost {:.1f}..{:.1f} s ({} scans): {}\n", stretch.from_s, stretch.to_s,
                stretch.scans, stretch.reason);
   }
+  if (h.sparse_scans > 0)
+    fmt::print("           {} sparse scans (lost packets or a blocked view), the first {:.1f}..{:.1f} s: {}\n",
+               h.sparse_scans, h.sparse.front().from_s, h.sparse.front().to_s,
+               h.sparse.front().reason);
   if (std::isfinite(h.median_innovation_deg))
     fmt::print(
         "           IMU prediction vs registration: {:.2f} deg, {:.3f} m per scan (median){}\n",

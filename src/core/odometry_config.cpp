@@ -50,6 +50,9 @@ void HealthConfig::visit(ConfigVisitor& v) {
   v.field("max_median_innovation_deg", max_median_innovation_deg,
           "deg, with an IMU: a median rotation between the IMU prediction and the registration "
           "above this over the run flags the rig's calibration or IMU noise settings as suspect");
+  v.field("sparse_scan_ratio", sparse_scan_ratio,
+          "scans with fewer points after the voxel filter than this fraction of the run's median "
+          "are reported as sparse (lost packets, a blocked view)");
   v.field("max_imu_gap_s", max_imu_gap_s,
           "s, with an IMU: a scan after a longer stretch without IMU readings is degraded and the "
           "IMU factor over the gap weakened");
@@ -70,6 +73,7 @@ void HealthConfig::validate() const {
   requirePositive("max_gyro_bias_dps", max_gyro_bias_dps, "deg/s");
   requirePositive("max_median_innovation_deg", max_median_innovation_deg, "deg");
   requirePositive("max_imu_gap_s", max_imu_gap_s, "s");
+  requireInRange("sparse_scan_ratio", sparse_scan_ratio, 0.0, 1.0, "");
 }
 
 void OdometryConfig::visit(ConfigVisitor& v) {

@@ -28,6 +28,8 @@ void HealthLog::onScan(const ScanOutcome& scan, const lie::SE3& /*T_map_odom*/) 
       break;
   }
   report_.map_segments = scan.map_segment + 1;
+  if (scan.lidar != LidarFactor::kFirstScan)  // the first scan of a model is not filtered
+    points_.emplace_back(scan.t_s, static_cast<double>(scan.source_points));
   const bool with_imu = !scan.imu_rate_poses.empty();
   if (with_imu && scan.lidar == LidarFactor::kUsed) {
     innovations_deg_.push_back(scan.innovation_deg);
@@ -52,7 +54,36 @@ void HealthLog::onScan(const ScanOutcome& scan, const lie::SE3& /*T_map_odom*/) 
   previous_ = h.status;
 }
 
+void HealthLog::findSparseScans() {
+  std::vector<double> counts;
+  for (const auto& [t_s, n] : points_) counts.push_back(n);
+  if (counts.empty()) return;
+  const double limit = config_.sparse_scan_ratio * percentile(counts, 50.0);
+  bool in_stretch = false;
+  for (const auto& [t_s, n] : points_) {
+    const bool sparse = n < limit;
+    if (sparse && in_stretch) {
+      report_.sparse.back().to_s = t_s;
+      ++report_.sparse.back().scans;
+    } else if (sparse) {
+      report_.sparse.push_back({"sparse", t_s, t_s, 1,
+                                fmt::format("fewer than {:.0f} points after the voxel filter "
+                                            "({:.0f} % of the run's median)",
+                                            limit, 100.0 * config_.sparse_scan_ratio)});
+    }
+    report_.sparse_scans += sparse;
+    in_stretch = sparse;
+  }
+  if (report_.sparse_scans > 0)
+    logger().warn(
+        "{} scans in {} stretches had fewer than {:.0f} % of the run's median points after the "
+        "voxel filter (lost packets or a blocked view), the first from {:.3f} s",
+        report_.sparse_scans, report_.sparse.size(), 100.0 * config_.sparse_scan_ratio,
+        report_.sparse.front().from_s);
+}
+
 HealthReport HealthLog::finish() {
+  findSparseScans();
   if (!innovations_deg_.empty()) {
     report_.median_innovation_deg = percentile(innovations_deg_, 50.0);
     report_.median_innovation_m = percentile(innovations_m_, 50.0);

@@ -36,6 +36,14 @@ nlohmann::ordered_json finiteOrNull(double value) {
 
 /// The health monitor's verdict and its stretches; degraded ones only the first few (scans.csv
 /// has every scan).
+nlohmann::ordered_json sparseJson(const HealthReport& h) {
+  nlohmann::ordered_json sparse = nlohmann::ordered_json::array();
+  for (const HealthStretch& s : h.sparse)
+    sparse.push_back(
+        {{"from_s", s.from_s}, {"to_s", s.to_s}, {"scans", s.scans}, {"reason", s.reason}});
+  return sparse;
+}
+
 nlohmann::ordered_json healthJson(const HealthReport& h) {
   constexpr std::size_t kListedDegraded = 20;
   nlohmann::ordered_json lost = nlohmann::ordered_json::array();
@@ -58,6 +66,8 @@ nlohmann::ordered_json healthJson(const HealthReport& h) {
           {"median_innovation_deg", finiteOrNull(h.median_innovation_deg)},
           {"median_innovation_m", finiteOrNull(h.median_innovation_m)},
           {"calibration_suspect", h.calibration_suspect},
+          {"sparse_scans", h.sparse_scans},
+          {"sparse", sparseJson(h)},
           {"lost", lost},
           {"degraded_stretches", degraded_stretches},
           {"degraded", degraded}};

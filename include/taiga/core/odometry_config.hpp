@@ -52,6 +52,9 @@ struct HealthConfig final : ConfigSection {
   /// With an IMU: a stretch without IMU readings longer than this before a scan degrades it, and
   /// the IMU factor over it is weakened to what the readings around it can tell, s.
   double max_imu_gap_s = 0.05;
+  /// Scans with fewer points after the voxel filter than this fraction of the run's median are
+  /// reported as sparse (lost packets, a blocked view): a run-level note, not a scan status.
+  double sparse_scan_ratio = 0.4;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

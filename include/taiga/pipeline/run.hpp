@@ -90,6 +90,11 @@ struct HealthReport {
   double median_innovation_deg = std::numeric_limits<double>::quiet_NaN();
   double median_innovation_m = std::numeric_limits<double>::quiet_NaN();
   bool calibration_suspect = false;
+  /// Stretches of scans with fewer points after the voxel filter than
+  /// odometry.health.sparse_scan_ratio of the run's median (status "sparse"): lost packets, a
+  /// blocked view. A note on the run; the scans' statuses are the monitor's.
+  std::vector<HealthStretch> sparse;
+  std::size_t sparse_scans = 0;
   /// Lost and not re-attached to the same map: the run ended lost or started a new segment.
   bool trackLost() const { return ended_lost || map_segments > 1; }
   /// "ok", "degraded", "recovered" (lost, then re-attached to the same map), "suspect" (the
