@@ -63,8 +63,8 @@ nlohmann::json gyroNoiseJson(const SystemConfig& configured, const pipeline::Sel
   j["registration_sigma_deg"] = e.registration_sigma_rad * kDegPerRad;
   const Eigen::Matrix3d& A = e.rate_error_matrix;
   j["rate_error_matrix"] = {asVector(A.row(0)), asVector(A.row(1)), asVector(A.row(2))};
-  const Eigen::Matrix3d& B = e.rate_change_matrix_s;
-  j["rate_change_matrix_s"] = {asVector(B.row(0)), asVector(B.row(1)), asVector(B.row(2))};
+  const Eigen::Matrix3d& D = e.rate_change_matrix_s;
+  j["rate_change_matrix_s"] = {asVector(D.row(0)), asVector(D.row(1)), asVector(D.row(2))};
   nlohmann::json lags = nlohmann::json::array();
   for (const calib::LagVariance& l : e.lags)
     lags.push_back({{"lag_scans", l.lag_scans},

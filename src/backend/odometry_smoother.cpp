@@ -155,7 +155,9 @@ void OdometrySmoother::optimize() {
   latest_.bias = newest.blocks.bias();
   const Eigen::Index n = H.rows();
   if (n < 15 || !H.allFinite()) {  // not evaluable: the covariance is unknown, not garbage
-    ++numerical_failures_;
+    logger().warn("odometry smoother: the window's factors were not finite at {:.3f} s; its "
+                  "covariance is reported as a weak prior's",
+                  newest.t_s);
     latest_.covariance = weakCovariance();
     return;
   }
@@ -193,9 +195,8 @@ void OdometrySmoother::marginalizeOldest() {
   if (H.rows() != 30 || !H_marginal.allFinite() || !b_marginal.allFinite()) {
     // The factors could not be evaluated (a non-finite IMU factor, e.g. across a long gap in
     // the readings): the next state keeps a weak prior at its estimate instead of a broken one.
-    ++numerical_failures_;
-    logger().warn("odometry smoother: the marginalized state's factors were not finite at {:.3f} s; "
-                  "the window keeps a weak prior instead",
+    logger().warn("odometry smoother: the marginalized state's factors were not finite at {:.3f} "
+                  "s; the window keeps a weak prior instead",
                   next.t_s);
     next.prior = std::make_unique<StatePrior>(next.blocks, weakCovariance());
   } else {

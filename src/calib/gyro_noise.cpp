@@ -111,11 +111,11 @@ std::vector<LagVariance> lagVariances(const std::vector<Sample>& samples, int sk
 
 /// The residuals' parts explained, to first order, by errors proportional to the rotation and to
 /// the change of the rate over the lag:
-///   r ~ A theta + B (omega(t_end) - omega(t_start))
+///   r ~ A theta + D (omega(t_end) - omega(t_start))
 /// A is the gyro's scale-factor and axis errors (omega_measured = (I + A) omega; 0.5-1.5 % on
 /// MEMS gyros, 2-6 mrad/s in a handheld's 0.4 rad/s of sway) and any scale error of the
-/// registrations' rotations. B is what follows the rate at the scans' ends: a time offset the
-/// rotation calibration left (B = -dt I; it fits no scale errors, and a drifting clock's offset is
+/// registrations' rotations. D is what follows the rate at the scans' ends: a time offset the
+/// rotation calibration left (D = -dt I; it fits no scale errors, and a drifting clock's offset is
 /// only right on average), and the deskew errors those scale errors cause in each scan. Left in,
 /// both grow with the lag like noise: with 1.5 % scale errors the density read 2x too high.
 /// Weighted least squares (each lag's variance), samples beyond 5 robust sigmas of their lag
@@ -125,8 +125,8 @@ std::vector<LagVariance> lagVariances(const std::vector<Sample>& samples, int sk
 /// eigen-directions above 100 times the sample count are fitted (a pull of under 1 %).
 struct RateError {
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-  Vector3d of(const Sample& s) const { return A * s.theta_rad + B * s.rate_change_radps; }
+  Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
+  Vector3d of(const Sample& s) const { return A * s.theta_rad + D * s.rate_change_radps; }
 };
 
 RateError fitRateError(const std::vector<Sample>& samples, const std::vector<LagVariance>& lags) {
@@ -134,7 +134,7 @@ RateError fitRateError(const std::vector<Sample>& samples, const std::vector<Lag
   for (const LagVariance& l : lags)
     for (std::size_t i = 0; i < kLags.size(); ++i)
       if (kLags[i] == l.lag_scans) variance[i] = l.variance_rad2;
-  constexpr int kN = 18;  // A and B, column by column
+  constexpr int kN = 18;  // A and D, column by column
   using Params = Eigen::Matrix<double, kN, 1>;
   auto jacobian = [](const Sample& s) {
     Eigen::Matrix<double, 3, kN> J;
@@ -168,7 +168,7 @@ RateError fitRateError(const std::vector<Sample>& samples, const std::vector<Lag
   RateError e;
   for (int c = 0; c < 3; ++c) {
     e.A.col(c) = p.segment<3>(3 * c);
-    e.B.col(c) = p.segment<3>(9 + 3 * c);
+    e.D.col(c) = p.segment<3>(9 + 3 * c);
   }
   return e;
 }
@@ -183,10 +183,10 @@ std::vector<GyroReading> corrected(const GyroNoiseInput& in, const Eigen::Matrix
 
 /// The residuals once the rate errors are found and taken out: A is folded into the readings'
 /// M (omega_measured = M omega) three times, so that the large rotations of the longest lags,
-/// where first order is not enough, end up with none left; B, which is not the gyro's, is
+/// where first order is not enough, end up with none left; D, which is not the gyro's, is
 /// subtracted from the last residuals.
 std::vector<Sample> residualsWithoutRateError(const GyroNoiseInput& in, Eigen::Matrix3d& M,
-                                              Eigen::Matrix3d& B) {
+                                              Eigen::Matrix3d& D) {
   M = Eigen::Matrix3d::Identity();
   std::vector<Sample> samples = residuals(in, corrected(in, M), in.offset_s);
   for (int round = 0; round < 3; ++round) {
@@ -197,7 +197,7 @@ std::vector<Sample> residualsWithoutRateError(const GyroNoiseInput& in, Eigen::M
   const RateError last = fitRateError(samples, lagVariances(samples, -1, {}));
   for (Sample& s : samples) s.r_rad -= last.of(s);
   M = M * (Eigen::Matrix3d::Identity() + last.A);
-  B = last.B;
+  D = last.D;
   return samples;
 }
 
@@ -271,8 +271,8 @@ std::string scientific(double v) { return fmt::format("{:.2g}", v); }
 
 GyroNoiseEstimate estimateGyroNoise(const GyroNoiseInput& input) {
   if (input.gyro.empty()) throw InputError("no gyro readings");
-  Eigen::Matrix3d M, B;
-  const std::vector<Sample> samples = residualsWithoutRateError(input, M, B);
+  Eigen::Matrix3d M, D;
+  const std::vector<Sample> samples = residualsWithoutRateError(input, M, D);
   std::vector<LagVariance> lags = lagVariances(samples, -1, {});
   if (lags.size() < kMinLags)
     throw InputError(fmt::format(
@@ -308,7 +308,7 @@ GyroNoiseEstimate estimateGyroNoise(const GyroNoiseInput& input) {
   e.density_sigma = std::max(densitySigma(fit), jackknife_sigma);
   e.rate_error_radps = std::sqrt(fit.p(2));
   e.rate_error_matrix = M - Eigen::Matrix3d::Identity();
-  e.rate_change_matrix_s = B;
+  e.rate_change_matrix_s = D;
   e.registration_sigma_rad = std::sqrt(fit.p(0) / 2.0);
   for (LagVariance& l : lags)
     l.model_rad2 = fit.p(0) + fit.p(1) * l.tau_s + fit.p(2) * l.tau_s * l.tau_s;

@@ -37,7 +37,9 @@ class ImuPrior final : public MotionPrior {
   /// Not across a gap in the readings, when the prediction is the constant-velocity one, nor
   /// for a second after it: the state the gap left may be off by degrees, which the lidar must
   /// be allowed to correct.
-  bool boundsJumps() const override { return !last_gap_end_s_ || predicted_t_s_ > *last_gap_end_s_ + 1.0; }
+  bool boundsJumps() const override {
+    return !last_gap_end_s_ || predicted_t_s_ > *last_gap_end_s_ + 1.0;
+  }
   MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) override;
   bool levelled() const override { return levelled_; }
   const std::string& initializationNote() const override { return initialization_note_; }

@@ -83,7 +83,7 @@ TEST(GyroNoise, ScaleAxisAndTimeErrorsAreNotTakenForNoise) {
     EXPECT_NEAR(e.density_radps_sqrthz, 2.5e-4, 0.15 * 2.5e-4) << "seed " << seed;
     EXPECT_LT((e.rate_error_matrix - (M - Eigen::Matrix3d::Identity())).norm(), 2e-3)
         << e.rate_error_matrix;
-    // The offset left over is B's diagonal, B = -dt I (its other terms trade with A's in a sway).
+    // The offset left over is D's diagonal, D = -dt I (its other terms trade with A's in a sway).
     EXPECT_NEAR(-e.rate_change_matrix_s.trace() / 3.0, 0.0015, 0.0003) << e.rate_change_matrix_s;
   }
 }

@@ -58,9 +58,6 @@ class OdometrySmoother {
                          const std::optional<PoseMeasurement>& measurement);
 
   const StateEstimate& latest() const { return latest_; }
-  /// Times the window's factors could not be evaluated or marginalized (non-finite), and a weak
-  /// prior or covariance stood in: a sign of a broken input (e.g. a long gap in the IMU).
-  std::size_t numericalFailures() const { return numerical_failures_; }
 
  private:
   struct Node;
@@ -70,7 +67,6 @@ class OdometrySmoother {
   OdometrySmootherOptions options_;
   std::deque<std::unique_ptr<Node>> window_;
   StateEstimate latest_;
-  std::size_t numerical_failures_ = 0;
 };
 
 }  // namespace taiga::backend

@@ -10,10 +10,12 @@
 // c: the two registrations' own noise, constant in the lag; N^2 tau: the gyro's angle random walk
 // (white rate noise of density N integrates to a variance N^2 tau, the slope of an Allan
 // variance); B^2 tau^2: a rate error that stays over the lag, the bias's departure from the
-// stretch's constant estimate and the scale and axis errors (B, rad/s RMS). Fitting (1) over
-// lags of 0.1 to a few seconds separates them, because the registrations' noise does not grow
-// with the lag while the gyro's does. The lidar is the reference, so this is an Allan analysis
-// in motion, without a static hour on a table.
+// stretch's constant estimate (B, rad/s RMS). Fitting (1) over lags of 0.1 to a few seconds
+// separates them, because the registrations' noise does not grow with the lag while the gyro's
+// does. The lidar is the reference, so this is an Allan analysis in motion, without a static
+// hour on a table. Before (1), the residual's parts proportional to the rotation (the gyro's
+// scale and axis errors, A) and to the change of the rate over the lag (a leftover time offset,
+// D) are fitted and taken out (gyro_noise.cpp): they too grow with the lag.
 //
 // The accelerometer's density is not measured: over the lags the registrations resolve, its
 // white noise moves the body by less than a millimetre, far below their noise.
@@ -55,9 +57,9 @@ struct GyroNoiseEstimate {
   /// diagonal the scale-factor errors (0.005 for 0.5 %), the rest axis misalignment (a rotation
   /// of the lidar is in R_c, not here). It also holds any scale error of the registrations.
   Eigen::Matrix3d rate_error_matrix = Eigen::Matrix3d::Zero();
-  /// The residual's part that follows the rate's change over the lag, r ~ B (omega(t_end) -
+  /// The residual's part that follows the rate's change over the lag, r ~ D (omega(t_end) -
   /// omega(t_start)), taken out before (1) too: a time offset the rotation calibration left
-  /// (B = -dt I) and the deskew errors of a gyro's scale errors, s.
+  /// (D = -dt I) and the deskew errors of a gyro's scale errors, s.
   Eigen::Matrix3d rate_change_matrix_s = Eigen::Matrix3d::Zero();
   std::vector<LagVariance> lags;
 };
