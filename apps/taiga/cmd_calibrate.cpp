@@ -54,7 +54,8 @@ nlohmann::json gyroNoiseJson(const SystemConfig& configured, const pipeline::Sel
   nlohmann::json j = {{"configured_radps_sqrthz", configured.odometry.imu.gyro_noise_density},
                       {"verdict", calib::toString(c.gyro_noise_verdict.kind)},
                       {"text", c.gyro_noise_verdict.text}};
-  if (c.gyro_noise_verdict.suggested > 0.0) j["suggested_radps_sqrthz"] = c.gyro_noise_verdict.suggested;
+  if (c.gyro_noise_verdict.suggested > 0.0)
+    j["suggested_radps_sqrthz"] = c.gyro_noise_verdict.suggested;
   if (!c.gyro_noise) return j;
   const calib::GyroNoiseEstimate& e = *c.gyro_noise;
   j["measured_radps_sqrthz"] = e.density_radps_sqrthz;
@@ -135,10 +136,12 @@ void writeCorrectedConfig(const std::filesystem::path& path, SystemConfig config
   out << fmt::format(
       "# Written by taiga calibrate from {} ({:.0f}-{:.0f} s): rig.lidar_time_offset_s and the\n"
       "# rotation of rig.T_body_lidar estimated, everything else (the lever arm too) as\n"
-      "# configured{}. calibration.json has the values, their 1-sigma and what the motion showed.\n",
+      "# configured{}. calibration.json has the values, their 1-sigma and what the motion "
+      "showed.\n",
       recording, c.from_s, c.to_s,
-      noise ? "\n# but odometry.imu.gyro_noise_density: measured, the configured one was understated"
-            : "");
+      noise
+          ? "\n# but odometry.imu.gyro_noise_density: measured, the configured one was understated"
+          : "");
   out << io::writeConfigYaml(config);
   if (!out) throw InputError(fmt::format("{}: cannot write", path.string()));
 }

@@ -50,9 +50,10 @@ void printHealth(const pipeline::HealthReport& h) {
                stretch.scans, stretch.reason);
   }
   if (h.sparse_scans > 0)
-    fmt::print("           {} sparse scans (lost packets or a blocked view), the first {:.1f}..{:.1f} s: {}\n",
-               h.sparse_scans, h.sparse.front().from_s, h.sparse.front().to_s,
-               h.sparse.front().reason);
+    fmt::print(
+        "           {} sparse scans (lost packets or a blocked view), the first {:.1f}..{:.1f} s: "
+        "{}\n",
+        h.sparse_scans, h.sparse.front().from_s, h.sparse.front().to_s, h.sparse.front().reason);
   if (std::isfinite(h.median_innovation_deg))
     fmt::print(
         "           IMU prediction vs registration: {:.2f} deg, {:.3f} m per scan (median){}\n",
@@ -78,7 +79,8 @@ void printCalibration(const pipeline::CalibrationRunReport& c) {
       "ms{}), R_body_lidar changed by {:.3f} deg (observable about: {})\n",
       c.passes, c.wall_time_s, 1e3 * c.time_offset_s, 1e3 * c.offset_change_s,
       1e3 * c.offset_sigma_s, c.offset_observable ? "" : ", not observable: kept",
-      c.rotation_change_deg, c.rotation_observable_axes.empty() ? "none" : c.rotation_observable_axes);
+      c.rotation_change_deg,
+      c.rotation_observable_axes.empty() ? "none" : c.rotation_observable_axes);
   if (!c.advice.empty()) fmt::print("           {}\n", c.advice);
   if (!c.gyro_noise_text.empty()) fmt::print("           {}\n", c.gyro_noise_text);
 }

@@ -1,8 +1,9 @@
 #include "taiga/backend/gnss_factor.hpp"
-#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
 #include <cmath>
+
+#include "taiga/backend/sqrt_information.hpp"
 
 namespace taiga::backend {
 namespace {
@@ -30,10 +31,7 @@ void writeEnuWorldBlock(const lie::SE3& T_enu_world, double* enu_block) {
 
 GnssFactor::GnssFactor(const Eigen::Vector3d& d_body, const Eigen::Vector3d& p_enu,
                        const Eigen::Matrix3d& covariance_enu_m2)
-    : d_body_(d_body),
-      p_enu_(p_enu),
-      sqrt_information_(
-          sqrtInformation<3>(covariance_enu_m2)) {}
+    : d_body_(d_body), p_enu_(p_enu), sqrt_information_(sqrtInformation<3>(covariance_enu_m2)) {}
 
 bool GnssFactor::Evaluate(double const* const* parameters, double* residuals,
                           double** jacobians) const {

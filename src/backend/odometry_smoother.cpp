@@ -155,9 +155,10 @@ void OdometrySmoother::optimize() {
   latest_.bias = newest.blocks.bias();
   const Eigen::Index n = H.rows();
   if (n < 15 || !H.allFinite()) {  // not evaluable: the covariance is unknown, not garbage
-    logger().warn("odometry smoother: the window's factors were not finite at {:.3f} s; its "
-                  "covariance is reported as a weak prior's",
-                  newest.t_s);
+    logger().warn(
+        "odometry smoother: the window's factors were not finite at {:.3f} s; its "
+        "covariance is reported as a weak prior's",
+        newest.t_s);
     latest_.covariance = weakCovariance();
     return;
   }
@@ -195,9 +196,10 @@ void OdometrySmoother::marginalizeOldest() {
   if (H.rows() != 30 || !H_marginal.allFinite() || !b_marginal.allFinite()) {
     // The factors could not be evaluated (a non-finite IMU factor, e.g. across a long gap in
     // the readings): the next state keeps a weak prior at its estimate instead of a broken one.
-    logger().warn("odometry smoother: the marginalized state's factors were not finite at {:.3f} "
-                  "s; the window keeps a weak prior instead",
-                  next.t_s);
+    logger().warn(
+        "odometry smoother: the marginalized state's factors were not finite at {:.3f} "
+        "s; the window keeps a weak prior instead",
+        next.t_s);
     next.prior = std::make_unique<StatePrior>(next.blocks, weakCovariance());
   } else {
     // The quadratic 1/2 d^T H' d + b'^T d is a Gaussian with mean next (+) (-H'^-1 b'). H' is

@@ -1,7 +1,8 @@
 #include "taiga/backend/pose_factor.hpp"
-#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
+
+#include "taiga/backend/sqrt_information.hpp"
 
 namespace taiga::backend {
 

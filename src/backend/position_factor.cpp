@@ -1,15 +1,14 @@
 #include "taiga/backend/position_factor.hpp"
-#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
+
+#include "taiga/backend/sqrt_information.hpp"
 
 namespace taiga::backend {
 
 PositionFactor::PositionFactor(const Eigen::Vector3d& p_world_measured,
                                const Eigen::Matrix3d& covariance)
-    : p_world_measured_(p_world_measured),
-      sqrt_information_(
-          sqrtInformation<3>(covariance)) {}
+    : p_world_measured_(p_world_measured), sqrt_information_(sqrtInformation<3>(covariance)) {}
 
 bool PositionFactor::Evaluate(double const* const* parameters, double* residuals,
                               double** jacobians) const {

@@ -1,7 +1,8 @@
 #include "taiga/backend/relative_pose_factor.hpp"
-#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
+
+#include "taiga/backend/sqrt_information.hpp"
 
 namespace taiga::backend {
 
@@ -29,8 +30,8 @@ bool RelativePoseFactor::Evaluate(double const* const* parameters, double* resid
   if (jacobians[0]) {
     Eigen::Map<Eigen::Matrix<double, 6, kPoseSize, Eigen::RowMajor>> J(jacobians[0]);
     J.setZero();
-    J.leftCols<6>() = -sqrt_information_ * Jr_inv * T_i_j.inverse().adjoint() *
-                      poseTangentToSe3(T_world_i);
+    J.leftCols<6>() =
+        -sqrt_information_ * Jr_inv * T_i_j.inverse().adjoint() * poseTangentToSe3(T_world_i);
   }
   if (jacobians[1]) {
     Eigen::Map<Eigen::Matrix<double, 6, kPoseSize, Eigen::RowMajor>> J(jacobians[1]);

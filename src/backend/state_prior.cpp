@@ -1,13 +1,13 @@
 #include "taiga/backend/state_prior.hpp"
-#include "taiga/backend/sqrt_information.hpp"
 
 #include <Eigen/Cholesky>
+
+#include "taiga/backend/sqrt_information.hpp"
 
 namespace taiga::backend {
 
 StatePrior::StatePrior(const StateBlocks& mean, const Matrix15& covariance)
-    : mean_(mean),
-      sqrt_information_(sqrtInformation<15>(covariance)) {}
+    : mean_(mean), sqrt_information_(sqrtInformation<15>(covariance)) {}
 
 bool StatePrior::Evaluate(double const* const* parameters, double* residuals,
                           double** jacobians) const {

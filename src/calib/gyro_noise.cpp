@@ -28,7 +28,7 @@ struct Sample {
   double t_s = 0.0;  ///< start of the lag (the jackknife's blocks)
   double tau_s = 0.0;
   Vector3d r_rad = Vector3d::Zero();
-  Vector3d theta_rad = Vector3d::Zero();  ///< the registrations' rotation over the lag
+  Vector3d theta_rad = Vector3d::Zero();          ///< the registrations' rotation over the lag
   Vector3d rate_change_radps = Vector3d::Zero();  ///< the gyro's rate at the lag's end - start
 };
 
@@ -103,8 +103,8 @@ std::vector<LagVariance> lagVariances(const std::vector<Sample>& samples, int sk
       const double sigma = 1.4826 * percentile(values, 50.0);
       variance += sigma * sigma / 3.0;
     }
-    lags.push_back({.lag_scans = kLags[l], .tau_s = tau_sum_s / n, .variance_rad2 = variance,
-                    .samples = n});
+    lags.push_back(
+        {.lag_scans = kLags[l], .tau_s = tau_sum_s / n, .variance_rad2 = variance, .samples = n});
   }
   return lags;
 }
@@ -351,10 +351,14 @@ NoiseVerdict judgeGyroNoise(const GyroNoiseEstimate& e, double configured) {
 
 const char* toString(NoiseVerdict::Kind kind) {
   switch (kind) {
-    case NoiseVerdict::Kind::kConsistent: return "consistent";
-    case NoiseVerdict::Kind::kUnderstated: return "understated";
-    case NoiseVerdict::Kind::kOverstated: return "overstated";
-    case NoiseVerdict::Kind::kUndetermined: return "undetermined";
+    case NoiseVerdict::Kind::kConsistent:
+      return "consistent";
+    case NoiseVerdict::Kind::kUnderstated:
+      return "understated";
+    case NoiseVerdict::Kind::kOverstated:
+      return "overstated";
+    case NoiseVerdict::Kind::kUndetermined:
+      return "undetermined";
   }
   return "undetermined";
 }

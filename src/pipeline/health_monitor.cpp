@@ -135,9 +135,9 @@ bool HealthMonitor::hasYardstick() const { return history_.size() >= kMinHistory
 bool HealthMonitor::registrationSuspect(double fitness_m2, double inlier_share) const {
   if (!std::isfinite(fitness_m2) || fitness_m2 > max_fitness_m2_) return true;
   return !historyProblems({.registered = true,
-                            .lidar = LidarFactor::kUsed,
-                            .fitness_m2 = fitness_m2,
-                            .inlier_share = inlier_share})
+                           .lidar = LidarFactor::kUsed,
+                           .fitness_m2 = fitness_m2,
+                           .inlier_share = inlier_share})
               .empty();
 }
 

@@ -63,9 +63,9 @@ class ImuPrior final : public MotionPrior {
   const ScanPreparation& preparation_;
   const registration::RegistrationConfig& registration_;
   Eigen::Vector3d gravity_odom_;
-  ImuBuffer imu_;  ///< readings in the body frame
+  ImuBuffer imu_;                            ///< readings in the body frame
   std::optional<StampedPose> state_before_;  ///< the state before the latest one
-  std::optional<double> last_gap_end_s_;  ///< the end of the last scan predicted across a gap
+  std::optional<double> last_gap_end_s_;     ///< the end of the last scan predicted across a gap
   backend::OdometrySmoother smoother_;
   std::optional<io::Scan> first_scan_;  ///< held until the second scan arrives
   /// The scan last predicted: its end time and the increment since the previous state.

@@ -124,7 +124,8 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
 /// calibration.at_start: the rig's time offset and rotation from the recording's first stretch
 /// (self_calibration.hpp), written into `config`; a recording that cannot be calibrated keeps
 /// the configured rig and the report says why.
-CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording, SystemConfig& config) {
+CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording,
+                                      SystemConfig& config) {
   CalibrationRunReport report;
   const auto start = Clock::now();
   try {
@@ -158,8 +159,8 @@ CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording, Sy
 
 }  // namespace
 
-RunSummary runOdometry(const std::filesystem::path& recording_path,
-                       const SystemConfig& configured, const RunOptions& options) {
+RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& configured,
+                       const RunOptions& options) {
   const std::filesystem::path& out = options.out_dir;
   createOutputDirectory(out);
   SystemConfig config = configured;
@@ -167,8 +168,9 @@ RunSummary runOdometry(const std::filesystem::path& recording_path,
   if (config.calibration.at_start && config.odometry.imu_use != "lidar_only") {
     if (options.realtime)  // a live sensor gives no stretch to read ahead
       calibration = CalibrationRunReport{
-          .skipped = "not under --realtime, which replays the recording as a live sensor would "
-                     "deliver it; calibrate with taiga calibrate first"};
+          .skipped =
+              "not under --realtime, which replays the recording as a live sensor would "
+              "deliver it; calibrate with taiga calibrate first"};
     else
       calibration = calibrateAtStart(recording_path, config);
   }

@@ -26,7 +26,7 @@ class HealthLog final : public SlamObserver {
   HealthConfig config_;
   HealthReport report_;
   std::vector<double> innovations_deg_, innovations_m_;  ///< used lidar factors, with an IMU
-  std::vector<std::pair<double, double>> points_;  ///< each scan's time and source points
+  std::vector<std::pair<double, double>> points_;        ///< each scan's time and source points
   /// The stretches of scans with few points (HealthReport::sparse).
   void findSparseScans();
   std::optional<ScanStatus> previous_;

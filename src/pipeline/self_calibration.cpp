@@ -136,12 +136,12 @@ void estimateLeverArm(PassData& data, double max_sigma_m, SelfCalibration& resul
 /// the configured one (the configuration's noise is what the odometry trusts).
 void estimateGyroNoise(const PassData& data, double configured, SelfCalibration& result) {
   try {
-    const calib::GyroNoiseEstimate e = calib::estimateGyroNoise(
-        {.chains = data.lever_arm.chains,
-         .gyro = data.gyro,
-         .offset_s = result.last.offset_s,
-         .R_correction = result.last.R_correction,
-         .bias_radps = result.last.gyro_bias_radps});
+    const calib::GyroNoiseEstimate e =
+        calib::estimateGyroNoise({.chains = data.lever_arm.chains,
+                                  .gyro = data.gyro,
+                                  .offset_s = result.last.offset_s,
+                                  .R_correction = result.last.R_correction,
+                                  .bias_radps = result.last.gyro_bias_radps});
     result.gyro_noise_verdict = calib::judgeGyroNoise(e, configured);
     logger().info("calibration: {}", result.gyro_noise_verdict.text);
     result.gyro_noise = e;
@@ -167,8 +167,8 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
   auto pass = [&](bool lidar_only, const calib::TimeRotationOptions& limits) {
     CalibrationPass p{.odometry = lidar_only ? "lidar-only" : "lidar-inertial"};
     try {
-      PassData data = runPass(recording, config, result.rig, lidar_only, result.from_s,
-                              result.to_s, margin_s);
+      PassData data =
+          runPass(recording, config, result.rig, lidar_only, result.from_s, result.to_s, margin_s);
       p.scans = data.scans;
       if (data.gyro.empty())
         throw InputError("the recording has no IMU readings in the stretch: nothing to calibrate");

@@ -7,11 +7,11 @@
 
 #include "machine_boxes_output.hpp"
 #include "outputs.hpp"
-#include "truth_outputs.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/io/rosbag.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/sim/random.hpp"
+#include "truth_outputs.hpp"
 
 namespace taiga::sim {
 namespace {
@@ -23,8 +23,7 @@ constexpr double kPlotMargin_m = 35.0;
 /// stamps are motion time + epoch), plus the drift of the lidar's clock. The drift within one
 /// scan (5 us at 50 ppm) is neglected.
 double lidarClockOffset_s(const RigErrorParams& rig, double t_start_s) {
-  if (rig.lidar_time_offset_s == 0.0 && rig.lidar_clock_drift_ppm == 0.0)
-    return kRecordingEpoch_s;
+  if (rig.lidar_time_offset_s == 0.0 && rig.lidar_clock_drift_ppm == 0.0) return kRecordingEpoch_s;
   return kRecordingEpoch_s - rig.lidar_time_offset_s + rig.lidar_clock_drift_ppm * 1e-6 * t_start_s;
 }
 
@@ -60,6 +59,7 @@ void dropPacketsOfBurst(io::Scan& scan, const FaultParams& f, double t_start_s, 
       t_start_s >= end_s - 1e-9)
     return;
   PointCloud& cloud = scan.cloud_in_lidar;
+  if (cloud.columns.size() != cloud.size()) return;  // the simulator always writes columns
   std::vector<std::size_t> kept;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const std::uint64_t packet = cloud.columns[i] / 16;
@@ -74,7 +74,8 @@ io::Scan splicedScan(const Simulation& sim, std::uint64_t index, double t_start_
                      double lidar_clock_s) {
   const LidarSimulator& lidar = sim.lidar();
   const FaultParams& f = sim.scenario().faults;
-  const auto from = static_cast<std::uint64_t>(std::llround(f.splice_from_s / lidar.scanPeriod_s()));
+  const auto from =
+      static_cast<std::uint64_t>(std::llround(f.splice_from_s / lidar.scanPeriod_s()));
   const double t_from_s = static_cast<double>(from) * lidar.scanPeriod_s();
   const double clock_from_s = lidarClockOffset_s(sim.scenario().rig, t_from_s);
   io::Scan scan = lidar.simulateScan(sim.scene(), sim.motion(), from, t_from_s, clock_from_s);

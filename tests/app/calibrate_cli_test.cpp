@@ -9,10 +9,10 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
-#include <vector>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
@@ -74,9 +74,9 @@ TEST(CalibrateCli, FindsTheTimeOffsetAndRotationOfATypicalRig) {
                "quaternion_xyzw: [0, 0, 0.7071067811865476, 0.7071067811865476]");
   std::ofstream(dir.file("rig_90.yaml")) << text;
   const auto out_90 = dir.file("calibrated_90");
-  const test::TaigaResult r90 = test::runTaiga("calibrate " + (sim / "recording.bag").string() +
-                                               " --config " + dir.file("rig_90.yaml").string() +
-                                               " --out " + out_90.string());
+  const test::TaigaResult r90 =
+      test::runTaiga("calibrate " + (sim / "recording.bag").string() + " --config " +
+                     dir.file("rig_90.yaml").string() + " --out " + out_90.string());
   ASSERT_EQ(r90.exit_code, 0) << r90.output;
   const nlohmann::json j90 = nlohmann::json::parse(std::ifstream(out_90 / "calibration.json"));
   EXPECT_EQ(j90["passes"][1]["odometry"], "lidar-only");

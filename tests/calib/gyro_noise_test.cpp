@@ -29,8 +29,8 @@ Vector3d omegaBody(const Vector3d& amplitude, double t) {
 }
 
 struct Rig {
-  double density = 2.5e-4;           ///< rad/s/sqrt(Hz)
-  double registration_sigma = 1e-4;  ///< rad per axis
+  double density = 2.5e-4;                          ///< rad/s/sqrt(Hz)
+  double registration_sigma = 1e-4;                 ///< rad per axis
   Eigen::Matrix3d M = Eigen::Matrix3d::Identity();  ///< scale and axis errors
   double duration_s = 30.0;
   Vector3d amplitude = kHandheld;
@@ -49,12 +49,13 @@ GyroNoiseInput simulate(const Rig& rig, unsigned seed) {
   const Vector3d bias(1e-3, -2e-3, 5e-4);
   in.bias_radps = bias;
   for (double t = 0.0; t <= rig.duration_s + 1.0; t += 1.0 / kRate_hz)
-    in.gyro.push_back({t + rig.gyro_late_s,
-                       rig.M * omegaBody(rig.amplitude, t) + bias + noise3(reading_sigma)});
+    in.gyro.push_back(
+        {t + rig.gyro_late_s, rig.M * omegaBody(rig.amplitude, t) + bias + noise3(reading_sigma)});
   in.chains.emplace_back();
   for (double t = 0.5; t < rig.duration_s; t += 0.1) {
     if (std::fmod(t, 9.0) < 0.1) in.chains.emplace_back();  // a scan not registered now and then
-    const lie::SO3 R = lie::SO3::Exp(theta(rig.amplitude, t)) * lie::SO3::Exp(noise3(rig.registration_sigma));
+    const lie::SO3 R =
+        lie::SO3::Exp(theta(rig.amplitude, t)) * lie::SO3::Exp(noise3(rig.registration_sigma));
     in.chains.back().push_back({t, lie::SE3(R, Vector3d::Zero())});
   }
   return in;
@@ -90,8 +91,8 @@ TEST(GyroNoise, ScaleAxisAndTimeErrorsAreNotTakenForNoise) {
 
 TEST(GyroNoise, AMachineThatOnlySlewsStillGivesTheDensity) {
   // Turning about z only: the rate error about x and y is not observable and stays zero.
-  const GyroNoiseEstimate e = estimateGyroNoise(
-      simulate({.density = 2.5e-4, .amplitude = Vector3d(0.0, 0.0, 2.0)}, 6));
+  const GyroNoiseEstimate e =
+      estimateGyroNoise(simulate({.density = 2.5e-4, .amplitude = Vector3d(0.0, 0.0, 2.0)}, 6));
   EXPECT_NEAR(e.density_radps_sqrthz, 2.5e-4, 0.15 * 2.5e-4);
   EXPECT_LT(e.rate_error_matrix.leftCols(2).cwiseAbs().maxCoeff(), 1e-3) << e.rate_error_matrix;
 }

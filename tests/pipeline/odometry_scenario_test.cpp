@@ -48,9 +48,9 @@ struct ScenarioRun {
 
 /// How the recording is made and which rig the run is told.
 struct RunSetup {
-  bool crop_machine = false;         ///< crop the harvester's machine with its per-scan boxes
-  std::string realism = "ideal";     ///< simulate --realism
-  std::string overrides;             ///< scenario fields (YAML) applied after the realism
+  bool crop_machine = false;          ///< crop the harvester's machine with its per-scan boxes
+  std::string realism = "ideal";      ///< simulate --realism
+  std::string overrides;              ///< scenario fields (YAML) applied after the realism
   std::string rig_file = "rig.yaml";  ///< as its user would write it, or rig_truth.yaml
   bool calibrate_at_start = false;    ///< calibration.at_start (docs/calibration.md)
 };
@@ -84,8 +84,7 @@ ScenarioRun simulateAndRun(const std::string& scenario_name, double duration_s, 
   run.evaluation = eval::evaluate(io::readTum(run_dir / "trajectory.tum"), truth, {});
   run.odometry_evaluation =
       eval::evaluate(io::readTum(run_dir / "trajectory_odometry.tum"), truth, {});
-  run.online_evaluation =
-      eval::evaluate(io::readTum(run_dir / "trajectory_online.tum"), truth, {});
+  run.online_evaluation = eval::evaluate(io::readTum(run_dir / "trajectory_online.tum"), truth, {});
   // Map sharpness (issue 7): 100k points of map.las, in the truth frame by the ATE's alignment.
   io::LasReader map(run_dir / "map.las");
   const PointCloud sample = map.readStrided(std::max<std::uint64_t>(1, map.pointCount() / 100000));
@@ -232,7 +231,8 @@ TEST(OdometryScenario, HandheldWalkWithImuOrientationStaysWithinCentimetresAndRe
   EXPECT_EQ(readFile(dir.path() / "run_rig" / "trajectory_imu.tum"),
             readFile(dir.path() / "rerun" / "trajectory_imu.tum"));
   // The map, exported from the keyframe store at the end of the run, too.
-  EXPECT_EQ(readFile(dir.path() / "run_rig" / "map.las"), readFile(dir.path() / "rerun" / "map.las"));
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "map.las"),
+            readFile(dir.path() / "rerun" / "map.las"));
   EXPECT_EQ(readFile(dir.path() / "run_rig" / "keyframes" / "poses.tum"),
             readFile(dir.path() / "rerun" / "keyframes" / "poses.tum"));
 }
@@ -350,8 +350,9 @@ TEST(OdometryScenario, TypicalRealismWithTheRigAUserWouldWriteOnThreeSeeds) {
     // Issue 20: the same rig.yaml, calibrated on the recording first. The time offset is found
     // to within a millisecond (the truth: 10 ms at the start, drifting 10 ppm); the lever arm
     // stays 3 cm off, which keeps the run above the true rig's.
-    const ScenarioRun calibrated = simulateAndRun(
-        "handheld-loop", 15.0, seed, dir.path(), {.realism = "typical", .calibrate_at_start = true});
+    const ScenarioRun calibrated =
+        simulateAndRun("handheld-loop", 15.0, seed, dir.path(),
+                       {.realism = "typical", .calibrate_at_start = true});
     expectEveryScanUsed(calibrated.summary);
     ASSERT_TRUE(calibrated.summary.calibration);
     const CalibrationRunReport& c = *calibrated.summary.calibration;

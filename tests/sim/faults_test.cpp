@@ -50,7 +50,8 @@ TEST(Faults, EachWhereItWasAskedFor) {
     } else if (std::abs(t_s - 2.5) < 0.05) {  // the splice: the scan from 0.5 s, stamped now
       const io::Scan& from = clean.scans[5];
       ASSERT_EQ(n_fault, from.cloud_in_lidar.size());
-      EXPECT_EQ(f.cloud_in_lidar.positions[n_fault / 2], from.cloud_in_lidar.positions[n_fault / 2]);
+      EXPECT_EQ(f.cloud_in_lidar.positions[n_fault / 2],
+                from.cloud_in_lidar.positions[n_fault / 2]);
       EXPECT_NEAR(f.cloud_in_lidar.times_s.front() - f.t_start_s,
                   from.cloud_in_lidar.times_s.front() - from.t_start_s, 1e-6);
     } else {

@@ -22,8 +22,8 @@ Eigen::Matrix<double, N, N> sqrtInformation(const Eigen::Matrix<double, N, N>& c
     if (S.allFinite()) return S;
   }
   const Eigen::SelfAdjointEigenSolver<Matrix> eigen(0.5 * (covariance + covariance.transpose()));
-  const auto lambda = eigen.eigenvalues().cwiseMax(
-      1e-12 * std::max(eigen.eigenvalues().maxCoeff(), 1e-300));
+  const auto lambda =
+      eigen.eigenvalues().cwiseMax(1e-12 * std::max(eigen.eigenvalues().maxCoeff(), 1e-300));
   return lambda.cwiseSqrt().cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
 }
 

@@ -42,16 +42,16 @@ struct GyroNoiseInput {
 /// The residual's variance at one lag (a point of the report's plot).
 struct LagVariance {
   int lag_scans = 0;
-  double tau_s = 0.0;           ///< mean lag
-  double variance_rad2 = 0.0;   ///< per axis (robust: 1.4826 MAD, squared, mean of the axes)
-  double model_rad2 = 0.0;      ///< (1) at tau_s with the fitted parameters
+  double tau_s = 0.0;          ///< mean lag
+  double variance_rad2 = 0.0;  ///< per axis (robust: 1.4826 MAD, squared, mean of the axes)
+  double model_rad2 = 0.0;     ///< (1) at tau_s with the fitted parameters
   std::size_t samples = 0;
 };
 
 struct GyroNoiseEstimate {
-  double density_radps_sqrthz = 0.0;  ///< N
-  double density_sigma = 0.0;         ///< its 1-sigma (the fit's or a block jackknife's, larger)
-  double rate_error_radps = 0.0;      ///< B
+  double density_radps_sqrthz = 0.0;    ///< N
+  double density_sigma = 0.0;           ///< its 1-sigma (the fit's or a block jackknife's, larger)
+  double rate_error_radps = 0.0;        ///< B
   double registration_sigma_rad = 0.0;  ///< sqrt(c / 2): one registration's rotation noise
   /// The gyro's rate error found and undone before (1): omega_measured = (I + this) omega, its
   /// diagonal the scale-factor errors (0.005 for 0.5 %), the rest axis misalignment (a rotation

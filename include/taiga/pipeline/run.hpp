@@ -113,14 +113,14 @@ struct CalibrationRunReport {
   bool offset_observable = false;
   double rotation_change_deg = 0.0;  ///< of R_body_lidar, from the configured one
   Eigen::Vector3d rotation_sigma_deg = Eigen::Vector3d::Zero();  ///< about body x, y, z
-  std::string rotation_observable_axes;  ///< e.g. "xyz", "xy", "" (none)
-  std::string advice;                    ///< what motion would calibrate what was not observable
+  std::string rotation_observable_axes;                          ///< e.g. "xyz", "xy", "" (none)
+  std::string advice;  ///< what motion would calibrate what was not observable
   /// The gyro's noise density measured against the registrations (calib/gyro_noise.hpp) and the
   /// verdict on odometry.imu.gyro_noise_density: reported, not applied (docs/calibration.md).
   std::string gyro_noise_verdict = "undetermined";
   std::string gyro_noise_text;
   double gyro_noise_measured = 0.0, gyro_noise_sigma = 0.0;  ///< rad/s/sqrt(Hz); 0: not measured
-  double gyro_noise_suggested = 0.0;                          ///< 0 when consistent
+  double gyro_noise_suggested = 0.0;                         ///< 0 when consistent
 };
 
 struct RunSummary {
@@ -145,8 +145,8 @@ struct RunSummary {
   double peak_memory_mb = 0.0;
   std::string initialization;
   HealthReport health;
-  std::optional<RealtimeReport> realtime;  ///< with --realtime only
-  std::optional<GeorefRunReport> georef;   ///< when the recording has GNSS fixes
+  std::optional<RealtimeReport> realtime;           ///< with --realtime only
+  std::optional<GeorefRunReport> georef;            ///< when the recording has GNSS fixes
   std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
 };
 
