@@ -41,9 +41,18 @@ TEST(ImuBuffer, KeepsTheReadingInForceWhenDroppingAndIgnoresRepeatedTimes) {
   buffer.dropBefore(0.505);
   EXPECT_NEAR(buffer.firstTime(), 0.5, 1e-9);  // the reading held over 0.505
   const std::vector<ImuSample> readings = buffer.between(0.505, 0.535);
-  ASSERT_EQ(readings.size(), 4u);  // 0.50, 0.51, 0.52, 0.53
+  ASSERT_EQ(readings.size(), 4u);                         // 0.50, 0.51, 0.52, 0.53
   EXPECT_EQ(buffer.signalOver(0.505, 0.535).size(), 5u);  // and 0.54, the one after the interval
   EXPECT_NEAR(readings.front().t_s, 0.5, 1e-9);
+}
+
+TEST(ImuBuffer, MeasuresTheLongestStretchWithoutReadings) {
+  ImuBuffer buffer;
+  for (double t : {0.00, 0.01, 0.02, 0.50, 0.51}) buffer.add({t, {}, {}, {}});
+  EXPECT_NEAR(buffer.longestGap(0.005, 0.015), 0.005, 1e-12);  // regular readings
+  EXPECT_NEAR(buffer.longestGap(0.015, 0.505), 0.48, 1e-12);   // the gap 0.02-0.50
+  EXPECT_NEAR(buffer.longestGap(0.1, 0.2), 0.1, 1e-12);        // wholly inside the gap
+  EXPECT_NEAR(buffer.longestGap(0.505, 0.9), 0.39, 1e-12);     // after the last reading
 }
 
 }  // namespace
