@@ -97,10 +97,8 @@ std::vector<LagVariance> lagVariances(const std::vector<Sample>& samples, int sk
     const std::size_t n = axis[0].size();
     if (n < kMinSamplesPerLag) continue;
     double variance = 0.0;
-    for (std::vector<double>& values : axis) {
-      const double median = percentile(values, 50.0);
-      for (double& v : values) v = std::abs(v - median);
-      const double sigma = 1.4826 * percentile(values, 50.0);
+    for (const std::vector<double>& values : axis) {
+      const double sigma = robustSigma(values);
       variance += sigma * sigma / 3.0;
     }
     lags.push_back(

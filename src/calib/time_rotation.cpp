@@ -231,9 +231,7 @@ std::vector<bool> inliers(const Problem& p, const State& s, double outlier_sigma
   std::vector<double> norms(p.size());
   for (std::size_t k = 0; k < p.size(); ++k) norms[k] = p.residual(k, s).norm();
   const double median = percentile(norms, 50.0);
-  std::vector<double> deviations(p.size());
-  for (std::size_t k = 0; k < p.size(); ++k) deviations[k] = std::abs(norms[k] - median);
-  const double sigma = 1.4826 * percentile(deviations, 50.0);
+  const double sigma = robustSigma(norms);
   std::vector<bool> keep(p.size());
   for (std::size_t k = 0; k < p.size(); ++k)
     keep[k] = norms[k] <= median + outlier_sigmas * std::max(sigma, 1e-6);

@@ -20,4 +20,11 @@ double percentile(std::span<const double> values, double p) {
   return fraction >= 0.5 ? b - (b - a) * (1.0 - fraction) : a + (b - a) * fraction;
 }
 
+double robustSigma(std::span<const double> values) {
+  const double median = percentile(values, 50.0);
+  std::vector<double> deviations(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) deviations[i] = std::abs(values[i] - median);
+  return 1.4826 * percentile(deviations, 50.0);
+}
+
 }  // namespace taiga

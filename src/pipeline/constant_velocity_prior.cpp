@@ -10,11 +10,7 @@ MotionPrediction ConstantVelocityPrior::predict(const io::Scan& scan) {
   };
   MotionPrediction prediction;
   prediction.T_odom_body = predictedAt(scan.t_end_s);
-  // Poses over the sweep every 10 ms (and at its end) for the deskew's interpolation.
-  constexpr double kStep_s = 0.01;
-  for (double t = scan.t_start_s; t < scan.t_end_s; t += kStep_s)
-    prediction.sweep_T_odom_body.append(t, predictedAt(t));
-  prediction.sweep_T_odom_body.append(scan.t_end_s, prediction.T_odom_body);
+  prediction.sweep_T_odom_body = sweepPoses(scan, predictedAt);
   predicted_ = Twist{scan.t_end_s, prediction.T_odom_body};
   return prediction;
 }

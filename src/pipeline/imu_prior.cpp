@@ -95,10 +95,8 @@ MotionPrediction ImuPrior::predict(const io::Scan& scan) {
   predicted_t_s_ = scan.t_end_s;
   if (in_gap) {
     prediction.T_odom_body = constantVelocityAt(scan.t_end_s);
-    constexpr double kStep_s = 0.01;  // poses over the sweep for the deskew's interpolation
-    for (double t = scan.t_start_s; t < scan.t_end_s; t += kStep_s)
-      prediction.sweep_T_odom_body.append(t, constantVelocityAt(t));
-    prediction.sweep_T_odom_body.append(scan.t_end_s, prediction.T_odom_body);
+    prediction.sweep_T_odom_body =
+        sweepPoses(scan, [this](double t_s) { return constantVelocityAt(t_s); });
     return prediction;
   }
   prediction.T_odom_body =

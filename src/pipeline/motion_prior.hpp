@@ -39,6 +39,18 @@ struct MotionPrediction {
   double imu_gap_s = 0.0;
 };
 
+/// Poses over a scan's sweep every 10 ms and at its end, for the deskew's interpolation, from a
+/// model of the pose at any time (the constant-velocity predictions).
+template <class PoseAt>
+Trajectory sweepPoses(const io::Scan& scan, PoseAt T_odom_body_at) {
+  constexpr double kStep_s = 0.01;
+  Trajectory sweep;
+  for (double t = scan.t_start_s; t < scan.t_end_s; t += kStep_s)
+    sweep.append(t, T_odom_body_at(t));
+  sweep.append(scan.t_end_s, T_odom_body_at(scan.t_end_s));
+  return sweep;
+}
+
 struct MotionState {
   lie::SE3 T_odom_body;
   Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();

@@ -11,4 +11,8 @@ namespace taiga {
 /// NaN when `values` is empty.
 double percentile(std::span<const double> values, double p);
 
+/// A standard deviation robust to outliers: 1.4826 times the median absolute deviation from the
+/// median (the factor makes it the sigma of a normal distribution). NaN when `values` is empty.
+double robustSigma(std::span<const double> values);
+
 }  // namespace taiga
