@@ -122,6 +122,15 @@ std::vector<const registration::NdtTarget*> LocalMap::ndtTargets() const {
   return targets;
 }
 const registration::KdTree& LocalMap::kdTree() const { return inUse(in_use_.kd_tree, "kd-tree"); }
+const registration::Occupancy& LocalMap::occupancy(double voxel_m) const {
+  if (!in_use_.occupancy || in_use_.occupancy_voxel_m != voxel_m) {
+    in_use_.occupancy =
+        std::make_unique<registration::Occupancy>(kdTree().points(), voxel_m);
+    in_use_.occupancy_voxel_m = voxel_m;
+  }
+  return *in_use_.occupancy;
+}
+
 const registration::GicpCloud& LocalMap::gicpCloud() const {
   return inUse(in_use_.gicp_cloud, "GICP cloud");
 }

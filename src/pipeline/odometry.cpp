@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "health_monitor.hpp"
+#include "wide_basin.hpp"
 #include "lidar_factor.hpp"
 #include "motion_prior.hpp"
 #include "scan_preparation.hpp"
@@ -16,13 +17,6 @@ namespace taiga::pipeline {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-/// A wide-basin candidate replaces the registration only when it overlaps the map this much
-/// better: a near tie is the same basin seen through noise.
-constexpr double kClearlyBetter = 1.1;
-/// The share of a scan that must lie on the map for a wide-basin candidate to count when the
-/// map's scans have no history yet.
-constexpr double kMinOverlapWithoutHistory = 0.5;
 
 double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
   return source_points > 0 ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
@@ -79,7 +73,8 @@ Odometry::Odometry(const OdometryConfig& config, const RigConfig& rig, bool lida
                  config.local_map_keyframes,
                  registration_.method == registration::Method::kGicp ? LocalMap::Target::kGicp
                                                                      : LocalMap::Target::kNdt),
-      health_(std::make_unique<HealthMonitor>(config.health, config.max_fitness_m2)) {}
+      health_(std::make_unique<HealthMonitor>(config.health, config.max_fitness_m2)),
+      wide_basin_(lidar_only ? std::make_unique<WideBasin>(config) : nullptr) {}
 
 Odometry::~Odometry() = default;
 
@@ -171,6 +166,7 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
     local_map_.clear();
     last_keyframe_T_odom_body_.reset();
     health_->forgetHistory();
+    if (wide_basin_) wide_basin_->forget();
     for (StampedPose& p : outcome.imu_rate_poses) p.pose = *update.T_odom_unlevelled * p.pose;
     outcome.T_odom_unlevelled = update.T_odom_unlevelled;
   }
@@ -179,6 +175,8 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   // 7. Health, then the keyframe test.
   stage = Clock::now();
   judgeHealth(outcome, has_map);
+  if (wide_basin_ && has_map && outcome.health.status == ScanStatus::kOk)
+    wide_basin_->rememberLast();
   maybeAddKeyframe(outcome, cloud_in_body);
   outcome.timing.map_ms = msSince(stage);
   outcome.timing.total_ms = msSince(start);
@@ -189,42 +187,9 @@ registration::RegistrationResult Odometry::registerToMap(const std::vector<Eigen
                                                          const lie::SE3& guess_T_odom_body) {
   local_map_.beginRegistration();
   registration::RegistrationResult result = alignToMap(source, guess_T_odom_body);
-  if (!lidar_only_) return result;  // the IMU predicts within centimetres
-  // A constant velocity is a poor prediction through a fast turn between sparse scans, and none
-  // at all for the second scan (it knows no velocity yet): the registration may have settled in
-  // a wrong basin. Against an established map the health monitor's yardstick tells; on the first
-  // scans of a map there is none, so they always search (docs/odometry.md, "Wide basin").
-  const bool established = health_->hasYardstick();
-  const auto suspect = [&](const registration::RegistrationResult& r) {
-    if (established)
-      return health_->registrationSuspect(r.fitness_m2, inlierShare(r, source.size()));
-    return !std::isfinite(r.fitness_m2) || r.fitness_m2 > config_.max_fitness_m2;
-  };
-  if (established && !suspect(result)) return result;
-  const auto overlap = [&](const registration::RegistrationResult& r) {
-    return registration::agreement(source, local_map_.kdTree(), r.T_target_source,
-                                   config_.ndt_resolution_m)
-        .share;
-  };
-  const double first_overlap = overlap(result);
-  double best_overlap = first_overlap;
-  for (const double yaw_deg : {-20.0, 20.0, -40.0, 40.0, -60.0, 60.0}) {
-    // Turned about the odom frame's vertical through the predicted position.
-    const lie::SO3 turn = lie::SO3::fromRollPitchYaw(0.0, 0.0, yaw_deg * kRadPerDeg);
-    const lie::SE3 guess(turn * guess_T_odom_body.rotation(), guess_T_odom_body.translation());
-    registration::RegistrationResult candidate = alignToMap(source, guess);
-    if (suspect(candidate)) continue;  // e.g. a partial scan: no candidate looks normal
-    const double candidate_overlap = overlap(candidate);
-    // Without a yardstick, half the scan must lie on the map (a map seeded by a sliver of a scan
-    // offers no basin worth choosing).
-    if (!established && candidate_overlap < kMinOverlapWithoutHistory) continue;
-    if (candidate_overlap > kClearlyBetter * best_overlap) {
-      best_overlap = candidate_overlap;
-      result = std::move(candidate);
-    }
-  }
-  logger().debug("wide-basin search: overlap {:.2f} -> {:.2f}", first_overlap, best_overlap);
-  return result;
+  if (!wide_basin_) return result;  // the IMU predicts within centimetres
+  return wide_basin_->widen(source, guess_T_odom_body, std::move(result), local_map_, *health_,
+                            [&](const lie::SE3& guess) { return alignToMap(source, guess); });
 }
 
 registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::Vector3d>& source,
@@ -271,6 +236,7 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
     local_map_.clear();
     last_keyframe_T_odom_body_.reset();
     health_->localMapRestarted(outcome.t_s);
+    if (wide_basin_) wide_basin_->forget();
     ++map_segment_;
     logger().warn("scan {} at {:.3f} s: lost for long, the local map starts over (segment {})",
                   outcome.scan_index, outcome.t_s, map_segment_);

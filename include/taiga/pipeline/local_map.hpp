@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "taiga/lie/se3.hpp"
+#include "taiga/registration/correlative_search.hpp"
 #include "taiga/registration/gicp.hpp"
 #include "taiga/registration/kdtree.hpp"
 #include "taiga/registration/ndt.hpp"
@@ -64,6 +65,9 @@ class LocalMap {
   std::vector<const registration::NdtTarget*> ndtTargets() const;
   const registration::KdTree& kdTree() const;
   const registration::GicpCloud& gicpCloud() const;
+  /// The voxels (of edge voxel_m) that the kd-tree's points occupy, for the correlative search;
+  /// built at the first call on the structures in use (none is built for maps never searched).
+  const registration::Occupancy& occupancy(double voxel_m) const;
 
  private:
   /// Sets the NDT passes (coarse to fine, at least one); only while the map is empty.
@@ -72,6 +76,8 @@ class LocalMap {
     std::vector<std::unique_ptr<registration::NdtTarget>> ndt_targets;  ///< coarse to fine
     std::unique_ptr<registration::GicpCloud> gicp_cloud;
     std::unique_ptr<registration::KdTree> kd_tree;
+    mutable std::unique_ptr<registration::Occupancy> occupancy;  ///< built on demand
+    mutable double occupancy_voxel_m = 0.0;
   };
   SearchStructures build() const;
   /// Waits for a background build and makes it the one in use.

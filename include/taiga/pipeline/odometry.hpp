@@ -39,6 +39,7 @@
 namespace taiga::pipeline {
 
 class HealthMonitor;
+class WideBasin;
 class MotionPrior;
 class ScanPreparation;
 struct FirstScan;
@@ -135,7 +136,7 @@ class Odometry {
   std::optional<ScanOutcome> processScan(const io::Scan& scan);
   ScanOutcome firstScanOutcome(FirstScan&& first);
   /// Registration to the local map, from the prediction and, without an IMU, when that looks
-  /// wrong, from other headings too.
+  /// wrong, from the wide basin's other starts too.
   registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
                                                  const lie::SE3& guess_T_odom_body);
   /// One registration from one guess, with its fitness.
@@ -151,6 +152,7 @@ class Odometry {
   std::unique_ptr<MotionPrior> motion_;
   LocalMap local_map_;
   std::unique_ptr<HealthMonitor> health_;
+  std::unique_ptr<WideBasin> wide_basin_;  ///< lidar-only
   std::uint64_t map_segment_ = 0;
   std::optional<lie::SE3> last_keyframe_T_odom_body_;
   std::uint64_t keyframes_made_ = 0;

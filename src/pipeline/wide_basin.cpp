@@ -1,0 +1,87 @@
+#include "wide_basin.hpp"
+
+#include <cmath>
+
+#include "taiga/core/angles.hpp"
+#include "taiga/core/log.hpp"
+#include "taiga/core/percentile.hpp"
+#include "taiga/registration/correlative_search.hpp"
+#include "taiga/registration/kdtree.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+/// Ok scans whose overlap is the yardstick.
+constexpr std::size_t kRecentScans = 10;
+constexpr std::size_t kMinRecent = 3;
+/// A registration overlapping the map less than this share of the recent median searches.
+constexpr double kSearchBelowRecent = 0.85;
+/// A searched registration replaces the first only when it overlaps the map this much better:
+/// a near tie is the same basin seen through noise, and the prediction is information too.
+constexpr double kClearlyBetter = 1.1;
+/// Without a yardstick, the share of a scan that must lie on the map for a searched
+/// registration to count (a map seeded by a sliver of a scan offers no basin worth choosing).
+constexpr double kMinOverlapWithoutHistory = 0.4;
+/// Starts proposed by the correlative search.
+constexpr std::size_t kStarts = 3;
+
+double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
+  return source_points > 0 ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
+                           : 0.0;
+}
+
+}  // namespace
+
+WideBasin::WideBasin(const OdometryConfig& config)
+    // A point on a surface lies within about one map spacing of the map's points when the pose
+    // is right; 8 deg off, a stem 3 m away is already 0.4 m off.
+    : overlap_distance_m_(1.5 * config.local_map_voxel_m), max_fitness_m2_(config.max_fitness_m2) {}
+
+double WideBasin::overlap(const std::vector<Eigen::Vector3d>& source, const LocalMap& map,
+                          const lie::SE3& T_odom_body) const {
+  return registration::agreement(source, map.kdTree(), T_odom_body, overlap_distance_m_).share;
+}
+
+registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vector3d>& source,
+                                                  const lie::SE3& guess_T_odom_body,
+                                                  registration::RegistrationResult first,
+                                                  const LocalMap& map,
+                                                  const HealthMonitor& health,
+                                                  const Align& align) {
+  const bool established = health.hasYardstick() && recent_overlaps_.size() >= kMinRecent;
+  const auto suspect = [&](const registration::RegistrationResult& r) {
+    if (health.hasYardstick())
+      return health.registrationSuspect(r.fitness_m2, inlierShare(r, source.size()));
+    return !std::isfinite(r.fitness_m2) || r.fitness_m2 > max_fitness_m2_;
+  };
+  last_overlap_ = overlap(source, map, first.T_target_source);
+  if (established && !suspect(first)) {
+    const std::vector<double> recent(recent_overlaps_.begin(), recent_overlaps_.end());
+    if (last_overlap_ >= kSearchBelowRecent * percentile(recent, 50.0)) return first;
+  }
+  const double first_overlap = last_overlap_;
+  registration::RegistrationResult best = std::move(first);
+  const std::vector<registration::CorrelativeCandidate> starts = registration::correlativeSearch(
+      source, map.occupancy(registration::CorrelativeWindow{}.voxel_m), guess_T_odom_body, {},
+      kStarts);
+  for (const registration::CorrelativeCandidate& start : starts) {
+    registration::RegistrationResult candidate = align(start.T_target_source);
+    if (suspect(candidate)) continue;  // e.g. a partial scan: no candidate looks normal
+    const double candidate_overlap = overlap(source, map, candidate.T_target_source);
+    if (!established && candidate_overlap < kMinOverlapWithoutHistory) continue;
+    if (candidate_overlap > kClearlyBetter * last_overlap_) {
+      last_overlap_ = candidate_overlap;
+      best = std::move(candidate);
+    }
+  }
+  logger().debug("wide-basin search: {} starts, overlap {:.2f} -> {:.2f}", starts.size(),
+                 first_overlap, last_overlap_);
+  return best;
+}
+
+void WideBasin::rememberLast() {
+  recent_overlaps_.push_back(last_overlap_);
+  while (recent_overlaps_.size() > kRecentScans) recent_overlaps_.pop_front();
+}
+
+}  // namespace taiga::pipeline
