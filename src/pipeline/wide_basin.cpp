@@ -1,5 +1,6 @@
 #include "wide_basin.hpp"
 
+#include <chrono>
 #include <cmath>
 
 #include "taiga/core/angles.hpp"
@@ -61,9 +62,12 @@ registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vecto
   }
   const double first_overlap = last_overlap_;
   registration::RegistrationResult best = std::move(first);
+  const auto search_start = std::chrono::steady_clock::now();
   const std::vector<registration::CorrelativeCandidate> starts = registration::correlativeSearch(
       source, map.occupancy(registration::CorrelativeWindow{}.voxel_m), guess_T_odom_body, {},
       kStarts);
+  const double search_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - search_start).count();
   for (const registration::CorrelativeCandidate& start : starts) {
     registration::RegistrationResult candidate = align(start.T_target_source);
     if (suspect(candidate)) continue;  // e.g. a partial scan: no candidate looks normal
@@ -74,8 +78,8 @@ registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vecto
       best = std::move(candidate);
     }
   }
-  logger().debug("wide-basin search: {} starts, overlap {:.2f} -> {:.2f}", starts.size(),
-                 first_overlap, last_overlap_);
+  logger().debug("wide-basin search: {} starts in {:.1f} ms, overlap {:.2f} -> {:.2f}",
+                 starts.size(), search_ms, first_overlap, last_overlap_);
   return best;
 }
 

@@ -262,6 +262,8 @@ const Field<FaultParams> kFaultFields[] = {
     {"packet_burst_loss", &FaultParams::packet_burst_loss, "share of their 16-column packets lost", 0, 1},
     {"splice_at_s", &FaultParams::splice_at_s, "the scan starting here is replaced (0: none), s", 0, 86400},
     {"splice_from_s", &FaultParams::splice_from_s, "by the scan simulated at this time, s", 0, 86400},
+    {"open_field_start_s", &FaultParams::open_field_start_s, "scans starting here see only the ground, s", 0, 86400},
+    {"open_field_s", &FaultParams::open_field_s, "for this long (0: none), s", 0, 86400},
 };
 
 const Field<OutputParams> kOutputFields[] = {

@@ -27,14 +27,19 @@ double lidarClockOffset_s(const RigErrorParams& rig, double t_start_s) {
   return kRecordingEpoch_s - rig.lidar_time_offset_s + rig.lidar_clock_drift_ppm * 1e-6 * t_start_s;
 }
 
+/// The true pose of the lidar at a time of the lidar's clock.
+auto lidarPoseAt(const WalkingMotion& motion, const lie::SE3& T_body_lidar, double lidar_clock_s) {
+  return [&motion, T_body_lidar, lidar_clock_s](double t_lidar_s) {
+    return motion.at(t_lidar_s - lidar_clock_s).T_world_body * T_body_lidar;
+  };
+}
+
 /// A scan as a front end that deskews upstream republishes it: every point moved, with the true
 /// motion, into the lidar frame at the scan's start (the header stamp), and no per-point times.
 void deskewWithTruth(io::Scan& scan, const WalkingMotion& motion, const lie::SE3& T_body_lidar,
                      double lidar_clock_s) {
   PointCloud& cloud = scan.cloud_in_lidar;
-  auto T_world_lidar = [&](double t_lidar_s) {
-    return motion.at(t_lidar_s - lidar_clock_s).T_world_body * T_body_lidar;
-  };
+  const auto T_world_lidar = lidarPoseAt(motion, T_body_lidar, lidar_clock_s);
   const lie::SE3 T_start_world = T_world_lidar(scan.t_start_s).inverse();
   lie::SE3 T_start_point;
   double t_cached = std::numeric_limits<double>::quiet_NaN();
@@ -85,6 +90,25 @@ io::Scan splicedScan(const Simulation& sim, std::uint64_t index, double t_start_
   scan.t_end_s += shift_s;
   for (double& t : scan.cloud_in_lidar.times_s) t += shift_s;
   return scan;
+}
+
+/// faults.open_field_*: a scan that starts in the window keeps only its ground returns.
+void clearTheForest(io::Scan& scan, const Simulation& sim, double t_start_s, double lidar_clock_s) {
+  const FaultParams& f = sim.scenario().faults;
+  if (f.open_field_s <= 0.0 || t_start_s < f.open_field_start_s - 1e-9 ||
+      t_start_s >= f.open_field_start_s + f.open_field_s - 1e-9)
+    return;
+  constexpr double kAboveGround_m = 0.3;
+  PointCloud& cloud = scan.cloud_in_lidar;
+  if (cloud.times_s.size() != cloud.size()) return;  // the simulator always writes times
+  const auto T_world_lidar = lidarPoseAt(sim.motion(), sim.lidar().T_body_lidar(), lidar_clock_s);
+  std::vector<std::size_t> kept;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d p_world = T_world_lidar(cloud.times_s[i]) * cloud.positions[i];
+    if (p_world.z() - sim.scene().terrain().height(p_world.x(), p_world.y()) <= kAboveGround_m)
+      kept.push_back(i);
+  }
+  cloud = cloud.select(kept);
 }
 
 bool isSplicedScan(const FaultParams& f, double t_start_s, double period_s) {
@@ -176,6 +200,7 @@ SimulationSummary writeSimulation(const Simulation& simulation,
                         ? splicedScan(simulation, k, t_start, lidar_clock_s)
                         : lidar.simulateScan(scene, motion, k, t_start, lidar_clock_s);
     dropPacketsOfBurst(scan, scenario.faults, t_start, lidar.scanPeriod_s(), simulation.seed());
+    clearTheForest(scan, simulation, t_start, lidar_clock_s);
     const double t_end = scan.t_end_s - lidar_clock_s;  // motion time: the scan is complete
     emitUntil(t_end);
     if (output.point_layout == "velodyne") {

@@ -1,6 +1,6 @@
 // Faults injected into a simulated recording (scenario section `faults`, docs/simulator.md
-// "Faults"): an IMU gap, a burst of lost packets and a scan from another place, each where it
-// was asked for and nowhere else.
+// "Faults"): an IMU gap, a burst of lost packets, a scan from another place and an open field,
+// each where it was asked for and nowhere else.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -59,6 +59,46 @@ TEST(Faults, EachWhereItWasAskedFor) {
       EXPECT_DOUBLE_EQ(c.t_start_s, f.t_start_s);
     }
   }
+}
+
+// The open field: the scans in the window keep only returns within 0.3 m of the terrain (checked
+// against the same simulation's truth), a subset of the clean scan's points; the others are
+// unchanged.
+TEST(Faults, AnOpenFieldKeepsOnlyTheGround) {
+  test::TempDir dir;
+  const Written clean = simulateAndRead(kSmall, dir, 2.0);
+  Scenario scenario;
+  const Written faulty = simulateAndRead(
+      std::string(kSmall) + "faults: {open_field_start_s: 0.5, open_field_s: 0.5}\n", dir, 2.0,
+      &scenario);
+  const Simulation truth(scenario, 2.0, 6);  // the seed of simulateAndRead
+  const lie::SE3 T_body_lidar = truth.lidar().T_body_lidar();
+  ASSERT_EQ(clean.scans.size(), faulty.scans.size());
+  const double scan0_s = clean.scans.front().t_start_s;
+  int open_scans = 0;
+  for (std::size_t k = 0; k < clean.scans.size(); ++k) {
+    const PointCloud& c = clean.scans[k].cloud_in_lidar;
+    const PointCloud& f = faulty.scans[k].cloud_in_lidar;
+    const double t_s = clean.scans[k].t_start_s - scan0_s;
+    if (t_s < 0.45 || t_s > 0.95) {
+      EXPECT_EQ(f.size(), c.size()) << "scan " << k;
+      continue;
+    }
+    ++open_scans;
+    EXPECT_LT(f.size(), c.size() * 9 / 10) << "scan " << k;  // the stems and crowns are gone
+    EXPECT_GT(f.size(), c.size() / 10) << "scan " << k;     // the ground is not
+    std::size_t checked = 0;
+    for (std::size_t i = 0; i < f.size(); i += 50, ++checked) {
+      const double t_motion_s = f.times_s[i] - kRecordingEpoch_s;
+      const Eigen::Vector3d p =
+          truth.motion().at(t_motion_s).T_world_body * T_body_lidar * f.positions[i];
+      EXPECT_LE(p.z() - truth.scene().terrain().height(p.x(), p.y()), 0.3 + 1e-6) << "scan " << k;
+      EXPECT_NE(std::find(c.positions.begin(), c.positions.end(), f.positions[i]),
+                c.positions.end());
+    }
+    EXPECT_GT(checked, 10u);
+  }
+  EXPECT_EQ(open_scans, 5);  // 0.5 s at 10 Hz
 }
 
 }  // namespace

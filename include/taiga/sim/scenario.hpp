@@ -217,6 +217,10 @@ struct FaultParams {
   /// another place, stamped as the scan it replaces.
   double splice_at_s = 0.0;
   double splice_from_s = 0.0;
+  /// The scans that start in [open_field_start_s, + open_field_s) see only the ground, as in a
+  /// clearing: returns more than 0.3 m above the terrain are dropped (0 s: none).
+  double open_field_start_s = 0.0;
+  double open_field_s = 0.0;
 };
 
 struct Scenario {
