@@ -5,7 +5,9 @@
 # switch `recording.deskewed: true`; APE against the truth and the health verdict.
 #
 #   bench/large_motion.sh [WORK_DIR]   (default /tmp/large_motion; environment:
-#       TAIGA=path/to/taiga, DURATION=60, SEEDS="1 2 3", HEADS="os0-128 hdl-32e")
+#       TAIGA=path/to/taiga, DURATION=60, SEEDS="1 2 3", HEADS="os0-128 hdl-32e",
+#       REALISM=ideal|typical|harsh: the lidar's and the scene's errors; the rig.yaml is the
+#       user's either way)
 #
 # Prints one Markdown row per head and seed.
 set -euo pipefail
@@ -14,6 +16,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 taiga=${TAIGA:-$here/../build/bin/taiga}
 work=${1:-/tmp/large_motion}
 duration=${DURATION:-60}
+realism=${REALISM:-ideal}
 mkdir -p "$work"
 
 echo "| head | seed | path (m) | largest turn between scans (deg) | APE RMSE (m) | APE max (m) | health | scans degraded / lost | exit |"
@@ -25,12 +28,12 @@ for head in ${HEADS:-os0-128 hdl-32e}; do
     *) echo "unknown head $head" >&2; exit 2 ;;
   esac
   for seed in ${SEEDS:-1 2 3}; do
-    sim=$work/sim_${head}_$seed
-    run=$work/run_${head}_$seed
+    sim=$work/sim_${realism}_${head}_$seed
+    run=$work/run_${realism}_${head}_$seed
     overrides=$work/overrides_$head.yaml
     printf '%s\noutput: {point_layout: deskewed, scan_stride: 5, imu: false, gnss: false}\n' \
       "$lidar" > "$overrides"
-    [[ -f $sim/groundtruth.tum ]] || "$taiga" simulate --scenario handheld-loop --seed "$seed" \
+    [[ -f $sim/groundtruth.tum ]] || "$taiga" simulate --scenario handheld-loop --realism "$realism" --seed "$seed" \
       --duration "$duration" --overrides "$overrides" --out "$sim" > "$sim.log" 2>&1
     sed 's/^  deskewed: false/  deskewed: true/' "$sim/rig.yaml" > "$sim/rig_deskewed.yaml"
     code=0

@@ -14,6 +14,12 @@
 
 namespace taiga::pipeline {
 
+/// A registration's inliers over the scan's source points, 0..1 (HealthEvidence::inlier_share).
+inline double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
+  return source_points > 0 ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
+                           : 0.0;
+}
+
 /// What the monitor is shown of one scan.
 struct HealthEvidence {
   double t_s = 0.0;

@@ -124,8 +124,7 @@ std::vector<const registration::NdtTarget*> LocalMap::ndtTargets() const {
 const registration::KdTree& LocalMap::kdTree() const { return inUse(in_use_.kd_tree, "kd-tree"); }
 const registration::Occupancy& LocalMap::occupancy(double voxel_m) const {
   if (!in_use_.occupancy || in_use_.occupancy_voxel_m != voxel_m) {
-    in_use_.occupancy =
-        std::make_unique<registration::Occupancy>(kdTree().points(), voxel_m);
+    in_use_.occupancy = std::make_unique<registration::Occupancy>(kdTree().points(), voxel_m);
     in_use_.occupancy_voxel_m = voxel_m;
   }
   return *in_use_.occupancy;

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "health_monitor.hpp"
-#include "wide_basin.hpp"
 #include "lidar_factor.hpp"
 #include "motion_prior.hpp"
 #include "scan_preparation.hpp"
@@ -12,16 +11,12 @@
 #include "taiga/core/log.hpp"
 #include "taiga/preprocess/voxel_filter.hpp"
 #include "taiga/registration/kdtree.hpp"
+#include "wide_basin.hpp"
 
 namespace taiga::pipeline {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
-  return source_points > 0 ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
-                           : 0.0;
-}
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();

@@ -1,5 +1,6 @@
 #include "wide_basin.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -25,10 +26,13 @@ constexpr double kClearlyBetter = 1.1;
 constexpr double kMinOverlapWithoutHistory = 0.4;
 /// Starts proposed by the correlative search.
 constexpr std::size_t kStarts = 3;
+/// Two registrations farther apart than this are distinct solutions, not one basin.
+constexpr double kDistinct_m = 0.3;
+constexpr double kDistinct_deg = 3.0;
 
-double inlierShare(const registration::RegistrationResult& r, std::size_t source_points) {
-  return source_points > 0 ? static_cast<double>(r.num_inliers) / static_cast<double>(source_points)
-                           : 0.0;
+bool distinct(const lie::SE3& a, const lie::SE3& b) {
+  const lie::Vector6 d = (a.inverse() * b).Log();
+  return d.head<3>().norm() > kDistinct_m || d.tail<3>().norm() * kDegPerRad > kDistinct_deg;
 }
 
 }  // namespace
@@ -36,7 +40,9 @@ double inlierShare(const registration::RegistrationResult& r, std::size_t source
 WideBasin::WideBasin(const OdometryConfig& config)
     // A point on a surface lies within about one map spacing of the map's points when the pose
     // is right; 8 deg off, a stem 3 m away is already 0.4 m off.
-    : overlap_distance_m_(1.5 * config.local_map_voxel_m), max_fitness_m2_(config.max_fitness_m2) {}
+    : overlap_distance_m_(1.5 * config.local_map_voxel_m),
+      max_fitness_m2_(config.max_fitness_m2),
+      degenerate_condition_(config.degenerate_condition) {}
 
 double WideBasin::overlap(const std::vector<Eigen::Vector3d>& source, const LocalMap& map,
                           const lie::SE3& T_odom_body) const {
@@ -46,8 +52,7 @@ double WideBasin::overlap(const std::vector<Eigen::Vector3d>& source, const Loca
 registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vector3d>& source,
                                                   const lie::SE3& guess_T_odom_body,
                                                   registration::RegistrationResult first,
-                                                  const LocalMap& map,
-                                                  const HealthMonitor& health,
+                                                  const LocalMap& map, const HealthMonitor& health,
                                                   const Align& align) {
   const bool established = health.hasYardstick() && recent_overlaps_.size() >= kMinRecent;
   const auto suspect = [&](const registration::RegistrationResult& r) {
@@ -67,15 +72,39 @@ registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vecto
       source, map.occupancy(registration::CorrelativeWindow{}.voxel_m), guess_T_odom_body, {},
       kStarts);
   const double search_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - search_start).count();
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - search_start)
+          .count();
+  struct Refined {
+    registration::RegistrationResult result;
+    double overlap;
+  };
+  std::vector<Refined> refined;
   for (const registration::CorrelativeCandidate& start : starts) {
     registration::RegistrationResult candidate = align(start.T_target_source);
-    if (suspect(candidate)) continue;  // e.g. a partial scan: no candidate looks normal
+    // A partial scan makes no candidate look normal; a degenerate one (a sliver, a field) leaves
+    // the search free to slide it a metre along what it does not constrain.
+    if (suspect(candidate) || !candidate.converged ||
+        candidate.hessian_condition > degenerate_condition_)
+      continue;
     const double candidate_overlap = overlap(source, map, candidate.T_target_source);
     if (!established && candidate_overlap < kMinOverlapWithoutHistory) continue;
-    if (candidate_overlap > kClearlyBetter * last_overlap_) {
-      last_overlap_ = candidate_overlap;
-      best = std::move(candidate);
+    refined.push_back({std::move(candidate), candidate_overlap});
+  }
+  const auto winner =
+      std::max_element(refined.begin(), refined.end(),
+                       [](const auto& a, const auto& b) { return a.overlap < b.overlap; });
+  if (winner != refined.end()) {
+    // The winner must stand out from the first result and from every distinct rival: a scan
+    // that fits several places about as well (a sliver, a row of like stems) is ambiguous, and
+    // the prediction then stays the better guess.
+    double rival_overlap = first_overlap;
+    for (const Refined& r : refined) {
+      if (distinct(r.result.T_target_source, winner->result.T_target_source))
+        rival_overlap = std::max(rival_overlap, r.overlap);
+    }
+    if (winner->overlap > kClearlyBetter * rival_overlap) {
+      last_overlap_ = winner->overlap;
+      best = std::move(winner->result);
     }
   }
   logger().debug("wide-basin search: {} starts in {:.1f} ms, overlap {:.2f} -> {:.2f}",

@@ -90,7 +90,8 @@ std::vector<CorrelativeCandidate> correlativeSearch(std::span<const Eigen::Vecto
     if (out.size() >= max_candidates) break;
     const GridPose g = gridPose(i);
     const bool near_better = std::any_of(kept.begin(), kept.end(), [&](const GridPose& k) {
-      return std::abs(k.yaw - g.yaw) <= 2 && std::abs(k.ix - g.ix) <= 2 && std::abs(k.iy - g.iy) <= 2;
+      return std::abs(k.yaw - g.yaw) <= 2 && std::abs(k.ix - g.ix) <= 2 &&
+             std::abs(k.iy - g.iy) <= 2;
     });
     if (near_better) continue;
     kept.push_back(g);

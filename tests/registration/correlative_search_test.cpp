@@ -101,7 +101,8 @@ TEST(CorrelativeSearch, AnEmptySourceOrTargetGivesNoStartOrAZeroScore) {
   const Occupancy empty(std::vector<Eigen::Vector3d>{}, 0.5);
   const std::vector<Eigen::Vector3d> source = {{1.0, 0.0, 0.0}};
   EXPECT_TRUE(correlativeSearch({}, empty, lie::SE3(), {}, 3).empty());
-  const std::vector<CorrelativeCandidate> starts = correlativeSearch(source, empty, lie::SE3(), {}, 1);
+  const std::vector<CorrelativeCandidate> starts =
+      correlativeSearch(source, empty, lie::SE3(), {}, 1);
   ASSERT_EQ(starts.size(), 1u);
   EXPECT_EQ(starts[0].score, 0.0);
 }
