@@ -61,7 +61,7 @@ registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vecto
     return !std::isfinite(r.fitness_m2) || r.fitness_m2 > max_fitness_m2_;
   };
   last_overlap_ = overlap(source, map, first.T_target_source);
-  if (established && !suspect(first)) {
+  if (established && first.converged && !suspect(first)) {
     const std::vector<double> recent(recent_overlaps_.begin(), recent_overlaps_.end());
     if (last_overlap_ >= kSearchBelowRecent * percentile(recent, 50.0)) return first;
   }
@@ -83,9 +83,7 @@ registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vecto
     registration::RegistrationResult candidate = align(start.T_target_source);
     // A partial scan makes no candidate look normal; a degenerate one (a sliver, a field) leaves
     // the search free to slide it a metre along what it does not constrain.
-    if (suspect(candidate) || !candidate.converged ||
-        candidate.hessian_condition > degenerate_condition_)
-      continue;
+    if (suspect(candidate) || candidate.hessian_condition > degenerate_condition_) continue;
     const double candidate_overlap = overlap(source, map, candidate.T_target_source);
     if (!established && candidate_overlap < kMinOverlapWithoutHistory) continue;
     refined.push_back({std::move(candidate), candidate_overlap});
@@ -105,6 +103,16 @@ registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vecto
     if (winner->overlap > kClearlyBetter * rival_overlap) {
       last_overlap_ = winner->overlap;
       best = std::move(winner->result);
+    }
+  }
+  if (!best.converged) {
+    // From a start far off, NDT may use up its iterations short of the minimum, or stop where
+    // the Hessian is not yet positive definite, and the lidar factor rejects that: it goes on
+    // from where it stopped.
+    registration::RegistrationResult again = align(best.T_target_source);
+    if (again.converged) {
+      last_overlap_ = overlap(source, map, again.T_target_source);
+      best = std::move(again);
     }
   }
   logger().debug("wide-basin search: {} starts in {:.1f} ms, overlap {:.2f} -> {:.2f}",

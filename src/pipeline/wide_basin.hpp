@@ -2,8 +2,8 @@
 // Lidar-only odometry's wide basin (docs/odometry.md, "Wide basin"): without an IMU the
 // constant-velocity prediction can be 50 deg and a metre off at low scan rates (a handheld walk
 // kept at 2 Hz), and NDT from there may settle in a wrong basin that still fits the map loosely.
-// When the registration from the prediction overlaps the map less than the recent scans did (or
-// before there is such a yardstick), a correlative search over heading and horizontal position
+// When the registration from the prediction overlaps the map less than the recent scans did, did
+// not converge, or there is no such yardstick yet, a correlative search over heading and horizontal position
 // (registration/correlative_search.hpp) proposes other starts; each is refined by the same NDT
 // and the one whose points lie closest to the map wins. Internal to the pipeline.
 
