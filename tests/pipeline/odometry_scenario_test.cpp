@@ -403,7 +403,7 @@ TEST(OdometryScenario, HarvesterWithTypicalRealism) {
 // pitch sway; run with the rig.yaml a user would write plus only the documented switch
 // recording.deskewed: true. Before the wide basin's correlative search (docs/odometry.md) both
 // heads diverged: APE 2.7-10 m, lost or silently wrong. Measured now: 2.3 cm (HDL-32E, seed 1),
-// 1.1 cm (64 of the OS0-128's beams, seed 2); bench/large_motion.sh has three seeds of each.
+// 1.1 cm (64 of the OS0-128's beams, seed 2); bench/BENCHMARK.md has six seeds of each head.
 TEST(OdometryScenario, LidarOnlyAtTwoHertzThroughFastTurnsStaysWithinDecimetres) {
   const std::string kept_at_2_hz =
       "output: {point_layout: deskewed, scan_stride: 5, imu: false, gnss: false}\n";
