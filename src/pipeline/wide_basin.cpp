@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 
-#include "taiga/core/angles.hpp"
 #include "taiga/core/log.hpp"
 #include "taiga/core/percentile.hpp"
 #include "taiga/registration/correlative_search.hpp"
@@ -31,8 +29,8 @@ constexpr double kDistinct_m = 0.3;
 constexpr double kDistinct_deg = 3.0;
 
 bool distinct(const lie::SE3& a, const lie::SE3& b) {
-  const lie::Vector6 d = (a.inverse() * b).Log();
-  return d.head<3>().norm() > kDistinct_m || d.tail<3>().norm() * kDegPerRad > kDistinct_deg;
+  const registration::Separation apart = registration::separation(a, b);
+  return apart.m > kDistinct_m || apart.deg > kDistinct_deg;
 }
 
 }  // namespace
@@ -41,7 +39,6 @@ WideBasin::WideBasin(const OdometryConfig& config)
     // A point on a surface lies within about one map spacing of the map's points when the pose
     // is right; 8 deg off, a stem 3 m away is already 0.4 m off.
     : overlap_distance_m_(1.5 * config.local_map_voxel_m),
-      max_fitness_m2_(config.max_fitness_m2),
       degenerate_condition_(config.degenerate_condition) {}
 
 double WideBasin::overlap(const std::vector<Eigen::Vector3d>& source, const LocalMap& map,
@@ -55,10 +52,9 @@ registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vecto
                                                   const LocalMap& map, const HealthMonitor& health,
                                                   const Align& align) {
   const bool established = health.hasYardstick() && recent_overlaps_.size() >= kMinRecent;
+  // Without a yardstick the monitor judges the fitness against max_fitness_m2 alone.
   const auto suspect = [&](const registration::RegistrationResult& r) {
-    if (health.hasYardstick())
-      return health.registrationSuspect(r.fitness_m2, inlierShare(r, source.size()));
-    return !std::isfinite(r.fitness_m2) || r.fitness_m2 > max_fitness_m2_;
+    return health.registrationSuspect(r.fitness_m2, inlierShare(r, source.size()));
   };
   last_overlap_ = overlap(source, map, first.T_target_source);
   if (established && first.converged && !suspect(first)) {

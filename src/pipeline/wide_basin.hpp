@@ -42,7 +42,6 @@ class WideBasin {
                  const lie::SE3& T_odom_body) const;
 
   double overlap_distance_m_;
-  double max_fitness_m2_;
   double degenerate_condition_;
   std::deque<double> recent_overlaps_;
   double last_overlap_ = 0.0;

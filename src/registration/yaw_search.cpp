@@ -6,7 +6,6 @@
 #include <numbers>
 #include <vector>
 
-#include "taiga/core/angles.hpp"
 #include "taiga/registration/kdtree.hpp"
 
 namespace taiga::registration {
@@ -16,12 +15,6 @@ struct Solution {
   RegistrationResult result;
   Agreement agreement;
 };
-
-/// Distance between two solutions: metres and degrees of T_a^-1 T_b.
-std::pair<double, double> apart(const lie::SE3& a, const lie::SE3& b) {
-  const lie::Vector6 d = (a.inverse() * b).Log();
-  return {d.head<3>().norm(), d.tail<3>().norm() * kDegPerRad};
-}
 
 }  // namespace
 
@@ -59,7 +52,7 @@ YawSearchResult registerWithYawSearch(std::span<const Eigen::Vector3d> source,
   out.best = solutions[best].result;
   out.overlap = solutions[best].agreement.share;
   for (const Solution& s : solutions) {
-    const auto [m, deg] = apart(out.best.T_target_source, s.result.T_target_source);
+    const auto [m, deg] = separation(out.best.T_target_source, s.result.T_target_source);
     const bool distinct = m > options.distinct_m || deg > options.distinct_deg;
     if (distinct && s.agreement.share > out.rival_overlap) {
       out.rival_overlap = s.agreement.share;

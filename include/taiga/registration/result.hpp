@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include "taiga/core/angles.hpp"
 #include "taiga/lie/se3.hpp"
 
 namespace taiga::registration {
@@ -40,6 +41,17 @@ struct RegistrationResult {
   /// Empty when converged; otherwise why not (empty cloud, too few points, planar input, ...).
   std::string reason;
 };
+
+/// How far apart two solutions lie, in metres and degrees of T_a^-1 T_b: what tells distinct
+/// solutions from one basin reached twice.
+struct Separation {
+  double m = 0.0;
+  double deg = 0.0;
+};
+inline Separation separation(const lie::SE3& a, const lie::SE3& b) {
+  const lie::Vector6 d = b.minus(a);
+  return {d.head<3>().norm(), d.tail<3>().norm() * kDegPerRad};
+}
 
 /// Condition number (largest / smallest eigenvalue) of a symmetric 6x6 matrix; infinity when the
 /// smallest eigenvalue is not positive.
