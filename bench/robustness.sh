@@ -6,7 +6,8 @@
 #   bench/robustness.sh [WORK_DIR]   (default /tmp/robustness; environment: TAIGA=path/to/taiga,
 #       SCENARIOS="handheld-loop harvester dense_spruce", REALISM="ideal typical harsh",
 #       SEEDS="1 2 3 4 5", DURATION_harvester=..., DURATION_<scenario>=... (default: the
-#       scenario's own), KEEP=1 to keep the recordings)
+#       scenario's own), BEAMS=64 to simulate fewer lidar rows (default: the full 128),
+#       KEEP=1 to keep the recordings)
 #
 # One row per run is appended to WORK_DIR/robustness.csv as soon as it is done; cells already in
 # it are skipped, so an interrupted table resumes. bench/robustness.py turns it into Markdown and
@@ -31,6 +32,9 @@ except Exception:
     print("nan nan nan nan nan")'
 }
 
+beam_args=()
+[[ -n ${BEAMS:-} ]] && beam_args=(--beams "$BEAMS")
+
 for scenario in ${SCENARIOS:-handheld-loop harvester dense_spruce}; do
   var=DURATION_${scenario//-/_}
   duration_args=()
@@ -42,7 +46,7 @@ for scenario in ${SCENARIOS:-handheld-loop harvester dense_spruce}; do
       run=$work/run_${scenario}_${realism}_$seed
       rm -rf "$sim" "$run"
       "$taiga" simulate --scenario "$scenario" --realism "$realism" --seed "$seed" \
-        "${duration_args[@]}" --out "$sim" > "$work/sim_${scenario}_${realism}_$seed.log" 2>&1
+        "${duration_args[@]}" "${beam_args[@]}" --out "$sim" > "$work/sim_${scenario}_${realism}_$seed.log" 2>&1
       code=0
       "$taiga" run "$sim/recording.bag" --config "$sim/rig.yaml" --out "$run" \
         > "$work/run_${scenario}_${realism}_$seed.log" 2>&1 || code=$?

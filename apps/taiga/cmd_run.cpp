@@ -63,6 +63,11 @@ void printHealth(const pipeline::HealthReport& h) {
               "are suspect (docs/odometry.md, Health); taiga calibrate or calibration.at_start "
               "estimates the first two (docs/calibration.md)"
             : "");
+  for (const pipeline::Reattachment& r : h.reattached)
+    fmt::print(
+        "           map segment {} re-attached to the map at {:.1f} s: {:.2f} m / {:.2f} deg from "
+        "dead reckoning, {:.0f} % of its points on the map\n",
+        r.segment, r.t_s, r.correction_m, r.correction_deg, 100.0 * r.overlap);
   if (h.trackLost())
     fmt::print(
         "           the track was lost and not re-attached: the trajectory and map after it are "

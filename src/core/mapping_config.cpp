@@ -26,6 +26,13 @@ void MappingConfig::visit(ConfigVisitor& v) {
   v.field("loop_max_chi2", loop_max_chi2,
           "loops that raise the optimal cost of the graph by more (as chi^2: twice the cost "
           "change) disagree with the odometry and are rejected as false");
+  v.field("relocalization", relocalization,
+          "search for a new map segment (started after the track was lost) in the map, and "
+          "re-attach it there");
+  v.field("relocalization_search_m", relocalization_search_m,
+          "m, the search reaches this far on each side of the dead-reckoned position, in x and y");
+  v.field("relocalization_search_deg", relocalization_search_deg,
+          "deg, and this far on each side of the dead-reckoned heading");
   v.field("odometry_sigma_m", odometry_sigma_m,
           "m, sigma of the translation between consecutive keyframes, at zero distance");
   v.field("odometry_sigma_m_per_m", odometry_sigma_m_per_m,
@@ -58,6 +65,8 @@ void MappingConfig::validate() const {
   requireInRange("loop_max_search_radius_m", loop_max_search_radius_m, loop_search_radius_m, 1000.0,
                  "m");
   requireNonNegative("loop_min_interval_s", loop_min_interval_s, "s");
+  requireInRange("relocalization_search_m", relocalization_search_m, 0.0, 20.0, "m");
+  requireInRange("relocalization_search_deg", relocalization_search_deg, 0.0, 180.0, "deg");
   requireInRange("loop_submap_keyframes", loop_submap_keyframes, 1, 100, "keyframes");
   requirePositive("loop_max_fitness_m2", loop_max_fitness_m2, "m^2");
   requireInRange("loop_max_rotation_deg", loop_max_rotation_deg, 0.1, 180.0, "deg");

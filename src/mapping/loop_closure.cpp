@@ -27,6 +27,54 @@ std::optional<LoopCandidate> findLoopCandidate(const PoseGraph& graph, std::size
   return best;
 }
 
+std::vector<Eigen::Vector3d> submapIn(const PoseGraph& graph, const KeyframeStore& store,
+                                      std::size_t frame, std::size_t first, std::size_t last,
+                                      const std::function<bool(std::size_t)>& keep) {
+  const lie::SE3 T_frame_map = graph.pose(frame).inverse();
+  std::vector<std::shared_ptr<const PointCloud>> clouds;
+  std::size_t submap_points = 0;
+  for (std::size_t k = first; k <= last; ++k) {
+    clouds.push_back(keep(k) ? store.registrationCloud(k) : nullptr);
+    if (clouds.back()) submap_points += clouds.back()->size();
+  }
+  // Sized once: grown by doubling it would leave freed blocks of up to twice its size behind in
+  // the mapping thread's heap at every attempt.
+  std::vector<Eigen::Vector3d> submap_in_frame;
+  submap_in_frame.reserve(submap_points);
+  for (std::size_t k = first; k <= last; ++k) {
+    if (!clouds[k - first]) continue;
+    const lie::SE3 T_frame_k = T_frame_map * graph.pose(k);
+    for (const Eigen::Vector3d& p_k : clouds[k - first]->positions)
+      submap_in_frame.push_back(T_frame_k * p_k);
+  }
+  return submap_in_frame;
+}
+
+registration::RegistrationConfig loopRegistrationConfig(const OdometryConfig& odometry) {
+  // The odometry's NDT passes (registrationConfigFor), after one at 3x its coarsest cells, all
+  // neighbouring cells scored: the guess may be off by the drift since the candidate, and a
+  // coarser pass widens the basin. NDT whatever the odometry's method, for that coarse pass.
+  registration::RegistrationConfig registration_config =
+      registration::registrationConfigFor(odometry);
+  registration_config.method = registration::Method::kNdt;
+  std::vector<double>& coarse_m = registration_config.ndt.coarse_resolutions_m;
+  const double coarsest_m =
+      coarse_m.empty() ? registration_config.ndt.resolution_m : coarse_m.front();
+  coarse_m.insert(coarse_m.begin(), 3.0 * coarsest_m);
+  registration_config.ndt.search = registration::NeighbourSearch::kDirect7;
+  return registration_config;
+}
+
+lie::Matrix6 loopCovariance(const OdometryConfig& odometry, double fitness_m2) {
+  // Thesis Eq. 36 as for the odometry's lidar factor, with the heading sigma on all three
+  // rotation axes: the odometry chain between the keyframes holds roll and pitch (gravity).
+  const LidarSigmas sigma = odometry.lidarSigmas(fitness_m2);
+  lie::Vector6 variances;
+  variances << lie::Vector3::Constant(sigma.translation_m * sigma.translation_m),
+      lie::Vector3::Constant(sigma.heading_rad * sigma.heading_rad);
+  return variances.asDiagonal().toDenseMatrix();
+}
+
 LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::size_t current,
                        const LoopCandidate& candidate, const MappingConfig& config,
                        const OdometryConfig& odometry) {
@@ -39,37 +87,13 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   const std::size_t last =
       std::min(candidate.keyframe + half,
                current - static_cast<std::size_t>(config.loop_exclude_recent_keyframes));
-  const lie::SE3 T_candidate_map = graph.pose(candidate.keyframe).inverse();
-  std::vector<std::shared_ptr<const PointCloud>> clouds;
-  std::size_t submap_points = 0;
-  for (std::size_t k = first; k <= last; ++k) {
-    clouds.push_back(store.registrationCloud(k));
-    submap_points += clouds.back()->size();
-  }
-  // Sized once: grown by doubling it would leave freed blocks of up to twice its size behind in
-  // the mapping thread's heap at every attempt.
-  std::vector<Eigen::Vector3d> submap_in_candidate;
-  submap_in_candidate.reserve(submap_points);
-  for (std::size_t k = first; k <= last; ++k) {
-    const lie::SE3 T_candidate_k = T_candidate_map * graph.pose(k);
-    for (const Eigen::Vector3d& p_k : clouds[k - first]->positions)
-      submap_in_candidate.push_back(T_candidate_k * p_k);
-  }
-
-  // The odometry's NDT passes (registrationConfigFor), after one at 3x its coarsest cells, all
-  // neighbouring cells scored: the guess may be off by the drift since the candidate, and a
-  // coarser pass widens the basin. NDT whatever the odometry's method, for that coarse pass.
-  registration::RegistrationConfig registration_config =
-      registration::registrationConfigFor(odometry);
-  registration_config.method = registration::Method::kNdt;
-  std::vector<double>& coarse_m = registration_config.ndt.coarse_resolutions_m;
-  const double coarsest_m =
-      coarse_m.empty() ? registration_config.ndt.resolution_m : coarse_m.front();
-  coarse_m.insert(coarse_m.begin(), 3.0 * coarsest_m);
-  registration_config.ndt.search = registration::NeighbourSearch::kDirect7;
-  const lie::SE3 guess_T_candidate_current = T_candidate_map * graph.pose(current);
-  attempt.registration = registration::registerClouds(
-      source->positions, submap_in_candidate, guess_T_candidate_current, registration_config);
+  const std::vector<Eigen::Vector3d> submap_in_candidate =
+      submapIn(graph, store, candidate.keyframe, first, last, [](std::size_t) { return true; });
+  const lie::SE3 guess_T_candidate_current =
+      graph.pose(candidate.keyframe).inverse() * graph.pose(current);
+  attempt.registration =
+      registration::registerClouds(source->positions, submap_in_candidate,
+                                   guess_T_candidate_current, loopRegistrationConfig(odometry));
   const registration::RegistrationResult& r = attempt.registration;
   const lie::Vector6 correction = (guess_T_candidate_current.inverse() * r.T_target_source).Log();
   attempt.correction_m = correction.head<3>().norm();
@@ -88,14 +112,8 @@ LoopAttempt verifyLoop(const PoseGraph& graph, const KeyframeStore& store, std::
   } else {
     attempt.accepted = true;
   }
-  // Thesis Eq. 36 as for the odometry's lidar factor, with the heading sigma on all three
-  // rotation axes: the odometry chain between the keyframes holds roll and pitch (gravity).
-  const LidarSigmas sigma = odometry.lidarSigmas(r.fitness_m2);
-  lie::Vector6 variances;
-  variances << lie::Vector3::Constant(sigma.translation_m * sigma.translation_m),
-      lie::Vector3::Constant(sigma.heading_rad * sigma.heading_rad);
   attempt.loop = RelativePose{candidate.keyframe, current, r.T_target_source,
-                              variances.asDiagonal().toDenseMatrix()};
+                              loopCovariance(odometry, r.fitness_m2)};
   return attempt;
 }
 

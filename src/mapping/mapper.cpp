@@ -20,11 +20,17 @@ Mapper::Mapper(const MappingConfig& config, const OdometryConfig& odometry,
   if (config.gnss_fusion) gnss_.emplace(config);
 }
 
-void Mapper::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body) {
-  const std::size_t index = graph_.addKeyframe(T_odom_body);
+void Mapper::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body,
+                         std::uint64_t segment) {
+  const std::size_t index = graph_.addKeyframe(T_odom_body, segment);
   if (index != id) throw std::logic_error("Mapper: keyframes must arrive in id order");
   keyframe_times_s_.push_back(t_s);
+  if (index == 0) attached_segments_.insert(segment);
   if (gnss_ && gnss_->afterKeyframe(graph_, keyframe_times_s_)) graph_.optimize();
+  if (!attached(index)) {
+    if (config_.relocalization) tryRelocalization(index, t_s);
+    return;
+  }
   if (!config_.loop_closure) return;
   if (last_attempt_s_ && t_s - *last_attempt_s_ < config_.loop_min_interval_s) return;
   tryLoopClosure(index, t_s);
@@ -49,9 +55,51 @@ std::optional<GnssFusionReport> Mapper::gnssReport() const {
   return gnss_->report(graph_);
 }
 
+std::vector<std::uint64_t> Mapper::reattachedSegments() const {
+  std::vector<std::uint64_t> out;
+  for (const RelocalizationRecord& r : relocalizations_)
+    if (r.attempt.accepted) out.push_back(r.segment);
+  return out;
+}
+
+void Mapper::tryRelocalization(std::size_t current, double t_s) {
+  if (last_relocalization_s_ && t_s - *last_relocalization_s_ < config_.loop_min_interval_s) return;
+  const Attached on_map = [this](std::size_t k) { return attached(k); };
+  const std::optional<std::size_t> candidate =
+      findRelocalizationCandidate(graph_, current, on_map, config_);
+  if (!candidate) return;
+  if (graph_.hasUnsolvedFactors()) graph_.optimize();
+  last_relocalization_s_ = t_s;
+  RelocalizationRecord record{
+      .t_s = t_s,
+      .segment = graph_.segment(current),
+      .attempt = relocalize(graph_, store_, current, *candidate, on_map, config_, odometry_)};
+  if (record.attempt.accepted) {
+    record.chi2 = graph_.addLoopIfConsistent(record.attempt.link, config_.loop_max_chi2);
+    if (record.chi2 <= config_.loop_max_chi2) {
+      attached_segments_.insert(record.segment);
+      logger().info(
+          "map segment {} re-attached at keyframe {} to keyframe {}: moved {:.2f} m / {:.2f} deg "
+          "from dead reckoning, {:.0f} % of its points on the map",
+          record.segment, current, *candidate, record.attempt.correction_m,
+          record.attempt.correction_deg, 100.0 * record.attempt.overlap);
+    } else {
+      record.attempt.accepted = false;
+      record.attempt.note = fmt::format("inconsistent with the graph: chi2 {:.1f} above {:.1f}",
+                                        record.chi2, config_.loop_max_chi2);
+    }
+  }
+  if (!record.attempt.accepted)
+    logger().debug("map segment {} not re-attached at keyframe {}: {}", record.segment, current,
+                   record.attempt.note);
+  relocalizations_.push_back(std::move(record));
+}
+
 void Mapper::tryLoopClosure(std::size_t current, double t_s) {
   const std::optional<LoopCandidate> candidate = findLoopCandidate(graph_, current, config_);
-  if (!candidate) return;
+  // A segment never re-attached lies where dead reckoning put it, held by no factor: a loop to it
+  // would pass any consistency test. Only a relocalization attaches it.
+  if (!candidate || !attached(candidate->keyframe)) return;
   // The consistency test compares optimal costs: GNSS factors paced out of the last solve
   // would be charged to the loop.
   if (graph_.hasUnsolvedFactors()) graph_.optimize();
@@ -86,8 +134,9 @@ MappingThread::~MappingThread() {
   if (worker_.joinable()) worker_.join();
 }
 
-void MappingThread::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body) {
-  push(KeyframeMessage{id, t_s, T_odom_body});
+void MappingThread::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body,
+                                std::uint64_t segment) {
+  push(KeyframeMessage{id, t_s, T_odom_body, segment});
 }
 
 void MappingThread::addGnssFix(const GnssFix& fix) { push(fix); }
@@ -111,7 +160,7 @@ void MappingThread::work() {
     lock.unlock();
     try {
       if (const auto* keyframe = std::get_if<KeyframeMessage>(&message)) {
-        mapper_.addKeyframe(keyframe->id, keyframe->t_s, keyframe->T_odom_body);
+        mapper_.addKeyframe(keyframe->id, keyframe->t_s, keyframe->T_odom_body, keyframe->segment);
         publish(keyframe->id);
       } else {
         mapper_.addGnssFix(std::get<GnssFix>(message));

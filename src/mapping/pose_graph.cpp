@@ -22,7 +22,7 @@ using PoseBlock = std::array<double, backend::kPoseSize>;
 
 PoseGraph::PoseGraph(const MappingConfig& config) : config_(config) {}
 
-std::size_t PoseGraph::addKeyframe(const lie::SE3& T_odom_body) {
+std::size_t PoseGraph::addKeyframe(const lie::SE3& T_odom_body, std::uint64_t segment) {
   const std::size_t index = odometry_poses_.size();
   if (index == 0) {
     poses_.push_back(T_odom_body);
@@ -33,15 +33,20 @@ std::size_t PoseGraph::addKeyframe(const lie::SE3& T_odom_body) {
     path_lengths_m_.push_back(path_lengths_m_.back() + T_prev_this.translation().norm());
   }
   odometry_poses_.push_back(T_odom_body);
+  segments_.push_back(segment);
   return index;
 }
 
 RelativePose PoseGraph::odometryBetween(std::size_t from, std::size_t to) const {
   const lie::SE3 T_from_to = odometry_poses_[from].inverse() * odometry_poses_[to];
   const double distance_m = T_from_to.translation().norm();
-  const double sigma_m = config_.odometry_sigma_m + config_.odometry_sigma_m_per_m * distance_m;
+  const bool bridge = segments_[from] != segments_[to];
+  const double sigma_m =
+      bridge ? kBridgeSigma_m
+             : config_.odometry_sigma_m + config_.odometry_sigma_m_per_m * distance_m;
   const double sigma_rad =
-      config_.odometry_sigma_rad + config_.odometry_sigma_rad_per_m * distance_m;
+      bridge ? kBridgeSigma_rad
+             : config_.odometry_sigma_rad + config_.odometry_sigma_rad_per_m * distance_m;
   lie::Vector6 variances;
   variances << lie::Vector3::Constant(sigma_m * sigma_m),
       lie::Vector3::Constant(sigma_rad * sigma_rad);

@@ -20,7 +20,7 @@ class ConstantVelocityPrior final : public MotionPrior {
     return last_ ? std::optional(last_->t_s) : std::nullopt;
   }
   MotionPrediction predict(const io::Scan& scan) override;
-  bool boundsJumps() const override { return false; }
+  std::optional<JumpBound> jumpBound() const override { return std::nullopt; }
   MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) override;
   bool levelled() const override { return true; }
   const std::string& initializationNote() const override { return note_; }

@@ -50,6 +50,8 @@ class HealthMonitor {
   /// Whether the recent history is long enough to judge against (not right after the local map
   /// started over).
   bool hasYardstick() const;
+  /// Time from the last ok scan to t_s, s; 0 before the first scan.
+  double sinceOk_s(double t_s) const { return last_ok_t_s_ ? t_s - *last_ok_t_s_ : 0.0; }
   /// True when the scan just judged asks for a fresh local map: lost on the current one for
   /// longer than reinitialize_after_s.
   bool restartLocalMap() const { return restart_local_map_; }

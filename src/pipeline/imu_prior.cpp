@@ -121,6 +121,11 @@ lie::SE3 ImuPrior::constantVelocityAt(double t_s) const {
   return T_latest * lie::SE3::Exp(twist_per_s * (t_s - latest.t_s));
 }
 
+std::optional<JumpBound> ImuPrior::jumpBound() const {
+  if (last_gap_end_s_ && predicted_t_s_ <= *last_gap_end_s_ + 1.0) return std::nullopt;
+  return JumpBound{.max_m = config_.max_jump_m, .max_deg = config_.max_jump_deg};
+}
+
 MotionUpdate ImuPrior::update(const std::optional<backend::PoseMeasurement>& lidar) {
   const backend::StateEstimate before = smoother_.latest();
   state_before_ = StampedPose{before.t_s, poseOf(before.state)};

@@ -34,12 +34,10 @@ class ImuPrior final : public MotionPrior {
   bool start(const io::Scan& scan, std::optional<FirstScan>& first) override;
   std::optional<double> stateTime() const override;
   MotionPrediction predict(const io::Scan& scan) override;
-  /// Not across a gap in the readings, when the prediction is the constant-velocity one, nor
-  /// for a second after it: the state the gap left may be off by degrees, which the lidar must
-  /// be allowed to correct.
-  bool boundsJumps() const override {
-    return !last_gap_end_s_ || predicted_t_s_ > *last_gap_end_s_ + 1.0;
-  }
+  /// max_jump_m / max_jump_deg. None across a gap in the readings, when the prediction
+  /// is the constant-velocity one, nor for a second after it: the state the gap left may be off
+  /// by degrees, which the lidar must be allowed to correct.
+  std::optional<JumpBound> jumpBound() const override;
   MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) override;
   bool levelled() const override { return levelled_; }
   const std::string& initializationNote() const override { return initialization_note_; }

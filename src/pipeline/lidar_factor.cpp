@@ -11,15 +11,15 @@ namespace taiga::pipeline {
 namespace {
 
 std::string rejection(const registration::RegistrationResult& r,
-                      const lie::SE3& predicted_T_odom_body, bool check_jump,
-                      const OdometryConfig& config) {
+                      const lie::SE3& predicted_T_odom_body,
+                      const std::optional<JumpBound>& jump_bound, const OdometryConfig& config) {
   const lie::Vector6 jump = (predicted_T_odom_body.inverse() * r.T_target_source).Log();
   const double jump_m = jump.head<3>().norm(), jump_deg = jump.tail<3>().norm() / kRadPerDeg;
   if (r.iterations == 0 || r.num_inliers == 0 || !std::isfinite(r.hessian_condition))
     return "registration failed: " + r.reason;
   if (!std::isfinite(r.fitness_m2) || r.fitness_m2 > config.max_fitness_m2)
     return fmt::format("fitness {:.3f} m^2 above {:.3f}", r.fitness_m2, config.max_fitness_m2);
-  if (check_jump && (jump_m > config.max_jump_m || jump_deg > config.max_jump_deg))
+  if (jump_bound && (jump_m > jump_bound->max_m || jump_deg > jump_bound->max_deg))
     return fmt::format("{:.3f} m / {:.2f} deg from the IMU prediction", jump_m, jump_deg);
   return {};
 }
@@ -50,11 +50,24 @@ lie::SE3 keepConstrainedDirections(const lie::SE3& predicted_T_odom_body,
 
 }  // namespace
 
+JumpBound grownByDeadReckoning(const JumpBound& bound, double since_ok_s) {
+  // Without a trusted scan (none arrived: a blocked view, lost packets; or they were distrusted)
+  // the pose is the IMU's dead reckoning, whose error grows with the square of the time: an
+  // attitude error of 1 deg leaks 0.17 m/s^2 of gravity into the acceleration, and a MEMS bias
+  // left over is a few 0.01 m/s^2. After 4 s without scans (`harsh` IMU) the pose was 0.7 m
+  // off, and the fixed bound rejected every scan that found it until the local map was given up.
+  constexpr double kUnmodelledAccel_mps2 = 0.2;
+  constexpr double kUnmodelledRate_dps = 0.5;  // gyro bias and scale errors left over in turns
+  return {.max_m = bound.max_m + 0.5 * kUnmodelledAccel_mps2 * since_ok_s * since_ok_s,
+          .max_deg = bound.max_deg + kUnmodelledRate_dps * since_ok_s};
+}
+
 LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
-                                     const lie::SE3& predicted_T_odom_body, bool check_jump,
+                                     const lie::SE3& predicted_T_odom_body,
+                                     const std::optional<JumpBound>& jump_bound,
                                      const OdometryConfig& config) {
   LidarFactorVerdict verdict;
-  verdict.note = rejection(r, predicted_T_odom_body, check_jump, config);
+  verdict.note = rejection(r, predicted_T_odom_body, jump_bound, config);
   if (!verdict.note.empty()) return verdict;
   // Thesis Eq. 36 (OdometryConfig::lidarSigmas, docs/odometry.md), ten times wider when the
   // registration did not converge or is degenerate.
@@ -68,7 +81,7 @@ LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& r,
                        : fmt::format("degenerate: Hessian condition {:.3g}", r.hessian_condition);
   }
   lie::SE3 T_odom_body = r.T_target_source;
-  if (!check_jump && r.hessian_condition > config.degenerate_condition &&
+  if (!jump_bound && r.hessian_condition > config.degenerate_condition &&
       std::isfinite(r.hessian_condition)) {
     // Without an IMU the prediction is a constant velocity and the measurement is taken as the
     // state whatever its covariance: the degenerate directions keep the prediction instead.

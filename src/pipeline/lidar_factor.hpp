@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "motion_prior.hpp"
 #include "taiga/backend/odometry_smoother.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/pipeline/odometry.hpp"
@@ -19,12 +20,17 @@ struct LidarFactorVerdict {
   std::optional<backend::PoseMeasurement> measurement;
 };
 
-/// Rejected when the registration failed, its fitness is above max_fitness_m2, or (with
-/// `check_jump`: the prediction comes from an IMU, good to centimetres) it lies farther than
-/// max_jump_m / max_jump_deg from `predicted_T_odom_body`; inflated ten-fold when it did not
-/// converge or is degenerate; used otherwise.
+/// `bound` grown with the time since the last scan the health monitor trusted, s: the IMU's dead
+/// reckoning drifts with its square (lidar_factor.cpp).
+JumpBound grownByDeadReckoning(const JumpBound& bound, double since_ok_s);
+
+/// Rejected when the registration failed, its fitness is above max_fitness_m2, or (with a
+/// `jump_bound`: the prediction comes from an IMU) it lies farther than the bound from
+/// `predicted_T_odom_body`; inflated ten-fold when it did not converge or is degenerate; used
+/// otherwise.
 LidarFactorVerdict judgeRegistration(const registration::RegistrationResult& registration,
-                                     const lie::SE3& predicted_T_odom_body, bool check_jump,
+                                     const lie::SE3& predicted_T_odom_body,
+                                     const std::optional<JumpBound>& jump_bound,
                                      const OdometryConfig& config);
 
 }  // namespace taiga::pipeline

@@ -51,6 +51,13 @@ Trajectory sweepPoses(const io::Scan& scan, PoseAt T_odom_body_at) {
   return sweep;
 }
 
+/// How far a registration may lie from the prediction before it is rejected (the lidar factor's
+/// jump test, lidar_factor.hpp).
+struct JumpBound {
+  double max_m = 0.0;
+  double max_deg = 0.0;
+};
+
 struct MotionState {
   lie::SE3 T_odom_body;
   Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();
@@ -86,9 +93,10 @@ class MotionPrior {
   /// The time of the latest state; none before the first.
   virtual std::optional<double> stateTime() const = 0;
   virtual MotionPrediction predict(const io::Scan& scan) = 0;
-  /// Whether the prediction is good to centimetres, so that a registration far from it is
-  /// suspect (IMU); a constant velocity ignores accelerations and is no such yardstick.
-  virtual bool boundsJumps() const = 0;
+  /// How far from the last prediction a registration is suspect, when the prediction is a
+  /// yardstick (IMU: good to centimetres over a scan); none for a constant velocity, which
+  /// ignores accelerations.
+  virtual std::optional<JumpBound> jumpBound() const = 0;
   /// The state at the end of the scan last predicted, with the lidar's measurement of T_odom_body
   /// (none when the registration was rejected or there was no map yet).
   virtual MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) = 0;

@@ -146,9 +146,12 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   // 5. Judge it; 6. fuse it with the motion prior.
   stage = Clock::now();
   LidarFactorVerdict verdict{.factor = LidarFactor::kFirstScan};
-  if (has_map)
-    verdict = judgeRegistration(outcome.registration, prediction.T_odom_body,
-                                motion_->boundsJumps(), config_);
+  if (has_map) {
+    std::optional<JumpBound> jump_bound = motion_->jumpBound();
+    if (jump_bound)
+      *jump_bound = grownByDeadReckoning(*jump_bound, health_->sinceOk_s(scan.t_end_s));
+    verdict = judgeRegistration(outcome.registration, prediction.T_odom_body, jump_bound, config_);
+  }
   outcome.lidar = verdict.factor;
   outcome.lidar_note = verdict.note;
   const MotionUpdate update = motion_->update(verdict.measurement);

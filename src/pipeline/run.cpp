@@ -198,6 +198,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   summary.wall_time_s = secondsSince(wall_start);
   scan_log.fillSummary(summary);
   summary.health = health.finish();
+  for (const mapping::RelocalizationRecord& r : mapper.relocalizationAttempts())
+    if (r.attempt.accepted)
+      summary.health.reattached.push_back(
+          {r.segment, r.t_s, r.attempt.correction_m, r.attempt.correction_deg, r.attempt.overlap});
   if (trajectories.odometry().empty())
     throw InputError(fmt::format(
         "{}: no scan could be processed ({} scans, {} IMU samples): the odometry needs at least "

@@ -44,6 +44,17 @@ nlohmann::ordered_json sparseJson(const HealthReport& h) {
   return sparse;
 }
 
+nlohmann::ordered_json reattachedJson(const HealthReport& h) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const Reattachment& r : h.reattached)
+    out.push_back({{"segment", r.segment},
+                   {"t_s", r.t_s},
+                   {"correction_m", r.correction_m},
+                   {"correction_deg", r.correction_deg},
+                   {"overlap", r.overlap}});
+  return out;
+}
+
 nlohmann::ordered_json healthJson(const HealthReport& h) {
   constexpr std::size_t kListedDegraded = 20;
   nlohmann::ordered_json lost = nlohmann::ordered_json::array();
@@ -62,6 +73,7 @@ nlohmann::ordered_json healthJson(const HealthReport& h) {
           {"scans_degraded", h.degraded},
           {"scans_lost", h.lost},
           {"map_segments", h.map_segments},
+          {"segments_reattached", reattachedJson(h)},
           {"ended_lost", h.ended_lost},
           {"median_innovation_deg", finiteOrNull(h.median_innovation_deg)},
           {"median_innovation_m", finiteOrNull(h.median_innovation_m)},

@@ -101,7 +101,7 @@ void SlamSystem::handleOutcome(const ScanOutcome& outcome, bool live) {
       store_.add(outcome.t_s, outcome.T_odom_body, *outcome.keyframe_cloud_in_body);
   if (id != *outcome.keyframe_id)
     throw std::logic_error("SlamSystem: the store's keyframe ids differ from the odometry's");
-  mapping_thread_.addKeyframe(id, outcome.t_s, outcome.T_odom_body);
+  mapping_thread_.addKeyframe(id, outcome.t_s, outcome.T_odom_body, outcome.map_segment);
   correction_->addKeyframe(id, outcome.T_odom_body);
   for (SlamObserver* observer : observers_) observer->onKeyframe(id, outcome);
   // 11. Follow the graph. Keyframes released after levelling predate the local map, which

@@ -203,6 +203,10 @@ SimulationSummary writeSimulation(const Simulation& simulation,
     clearTheForest(scan, simulation, t_start, lidar_clock_s);
     const double t_end = scan.t_end_s - lidar_clock_s;  // motion time: the scan is complete
     emitUntil(t_end);
+    if (scan.cloud_in_lidar.empty()) {  // every packet lost: the driver publishes nothing
+      if (on_scan) on_scan(k + 1, scans);
+      continue;
+    }
     if (output.point_layout == "velodyne") {
       bag.writeScanAs(io::ScanLayout::kVelodyne, kLidarTopic, "velodyne", scan);
     } else if (output.point_layout == "deskewed") {

@@ -27,6 +27,11 @@ struct MappingConfig final : ConfigSection {
   /// 25 is chi^2(6 dof) at 99.97 %; true loops measured up to 4.6 (bench/BENCHMARK.md), a false
   /// loop 1.5 m / 3 deg off after 200 m without an earlier loop at 46.8 (session 20).
   double loop_max_chi2 = 25.0;
+  // Relocalization (mapping/relocalization.hpp): a map segment the odometry started after it was
+  // lost is searched for in the map, within this window around its dead-reckoned pose.
+  bool relocalization = true;
+  double relocalization_search_m = 4.0;     ///< m, on each side, in x and in y
+  double relocalization_search_deg = 45.0;  ///< deg of heading, on each side
   // Odometry between consecutive keyframes: sigma = floor + per-metre growth * distance.
   double odometry_sigma_m = 0.002;
   double odometry_sigma_m_per_m = 0.003;

@@ -13,6 +13,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 #include <variant>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/mapping/loop_closure.hpp"
 #include "taiga/mapping/pose_graph.hpp"
+#include "taiga/mapping/relocalization.hpp"
 
 namespace taiga::mapping {
 
@@ -33,6 +35,14 @@ struct LoopRecord {
   double t_s = 0.0;
   LoopAttempt attempt;
   double chi2 = 0.0;  ///< cost the loop added, as chi^2 (0 when it did not get that far)
+};
+
+/// One attempt to re-attach a map segment (relocalization.hpp) and what became of it.
+struct RelocalizationRecord {
+  double t_s = 0.0;
+  std::uint64_t segment = 0;
+  RelocalizationAttempt attempt;
+  double chi2 = 0.0;  ///< cost the link added, as chi^2 (0 when it did not get that far)
 };
 
 /// Checks a loop candidate: loop_closure.hpp's verifyLoop, or a stand-in that injects false loops
@@ -47,9 +57,12 @@ class Mapper {
   Mapper(const MappingConfig& config, const OdometryConfig& odometry, const KeyframeStore& store,
          LoopVerifier verify_loop = verifyLoop);
 
-  /// Keyframe `id` of the store (ids in order, from 0) at its odometry pose. The graph's map
-  /// frame starts as the odom frame at the first keyframe.
-  void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
+  /// Keyframe `id` of the store (ids in order, from 0) at its odometry pose, in the odometry's
+  /// map segment `segment`. The graph's map frame starts as the odom frame at the first
+  /// keyframe; the first keyframe's segment is attached to the map, a later one once it is
+  /// relocalized in it (relocalization.hpp). Until then its keyframes try that instead of loops.
+  void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body,
+                   std::uint64_t segment = 0);
   /// A GNSS fix (recording clock); used when MappingConfig::gnss_fusion is on, ignored
   /// otherwise. It waits for the first keyframe at or after its time (gnss_fusion.hpp).
   void addGnssFix(const GnssFix& fix);
@@ -64,9 +77,18 @@ class Mapper {
   Trajectory keyframeTrajectory() const;
   const std::vector<LoopRecord>& loopAttempts() const { return attempts_; }
   std::size_t loopClosures() const { return graph_.loops().size(); }
+  const std::vector<RelocalizationRecord>& relocalizationAttempts() const {
+    return relocalizations_;
+  }
+  /// Segments that were re-attached to the map, in order.
+  std::vector<std::uint64_t> reattachedSegments() const;
 
  private:
   void tryLoopClosure(std::size_t current, double t_s);
+  void tryRelocalization(std::size_t current, double t_s);
+  bool attached(std::size_t keyframe) const {
+    return attached_segments_.contains(graph_.segment(keyframe));
+  }
 
   MappingConfig config_;
   OdometryConfig odometry_;
@@ -77,6 +99,9 @@ class Mapper {
   std::optional<GnssFusion> gnss_;
   std::optional<double> last_attempt_s_;
   std::vector<LoopRecord> attempts_;
+  std::set<std::uint64_t> attached_segments_;
+  std::optional<double> last_relocalization_s_;
+  std::vector<RelocalizationRecord> relocalizations_;
 };
 
 /// The mapping graph's poses of the newest keyframes right after it handled one keyframe: what
@@ -105,7 +130,8 @@ class MappingThread {
   MappingThread(const MappingThread&) = delete;
   MappingThread& operator=(const MappingThread&) = delete;
 
-  void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body);
+  void addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body,
+                   std::uint64_t segment = 0);
   /// Fixes are handled in the order of the calls, interleaved with the keyframes, so the
   /// result depends on that order only, not on the thread's timing.
   void addGnssFix(const GnssFix& fix);
@@ -123,6 +149,7 @@ class MappingThread {
     std::size_t id;
     double t_s;
     lie::SE3 T_odom_body;
+    std::uint64_t segment;
   };
   using Message = std::variant<KeyframeMessage, GnssFix>;
   void push(Message message);

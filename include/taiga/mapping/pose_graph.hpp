@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -50,8 +51,14 @@ class PoseGraph {
 
   /// Appends a keyframe at its odometry pose and returns its index (0, 1, ...). From the
   /// second on, an odometry factor joins it to the previous keyframe, with the sigmas of
-  /// MappingConfig grown with the distance between them.
-  std::size_t addKeyframe(const lie::SE3& T_odom_body);
+  /// MappingConfig grown with the distance between them; across a change of the odometry's map
+  /// `segment` (it was lost and started over, placed by dead reckoning) that factor carries no
+  /// weight (kBridgeSigma_m / _rad): only a relocalization or GNSS ties the segments together.
+  std::size_t addKeyframe(const lie::SE3& T_odom_body, std::uint64_t segment = 0);
+  /// The odometry's map segment of a keyframe.
+  std::uint64_t segment(std::size_t keyframe) const { return segments_[keyframe]; }
+  static constexpr double kBridgeSigma_m = 1e4;
+  static constexpr double kBridgeSigma_rad = 1e2;
   /// A loop closure factor (from < to).
   void addLoop(const RelativePose& loop);
   /// Adds `loop` and re-optimizes when the loop agrees with the graph: when it raises the
@@ -105,6 +112,7 @@ class PoseGraph {
 
   MappingConfig config_;
   std::vector<lie::SE3> odometry_poses_;
+  std::vector<std::uint64_t> segments_;
   std::vector<lie::SE3> poses_;
   std::vector<double> path_lengths_m_;
   std::vector<RelativePose> loops_;

@@ -76,6 +76,14 @@ struct HealthStretch {
   std::string reason;  ///< the first scan's
 };
 
+/// A map segment the mapping graph found in the map and tied to it (mapping/relocalization.hpp).
+struct Reattachment {
+  std::uint64_t segment = 0;
+  double t_s = 0.0;                                 ///< of the keyframe that was found
+  double correction_m = 0.0, correction_deg = 0.0;  ///< from where dead reckoning had put it
+  double overlap = 0.0;                             ///< share of the keyframe's points on the map
+};
+
 /// What the odometry's health monitor said over the run (docs/odometry.md, "Health").
 struct HealthReport {
   std::size_t ok = 0, degraded = 0, lost = 0;
@@ -95,8 +103,10 @@ struct HealthReport {
   /// blocked view. A note on the run; the scans' statuses are the monitor's.
   std::vector<HealthStretch> sparse;
   std::size_t sparse_scans = 0;
-  /// Lost and not re-attached to the same map: the run ended lost or started a new segment.
-  bool trackLost() const { return ended_lost || map_segments > 1; }
+  std::vector<Reattachment> reattached;  ///< segments after the first that were found again
+  /// Lost and not re-attached to the same map: the run ended lost, or started a segment that
+  /// was not re-attached.
+  bool trackLost() const { return ended_lost || map_segments > 1 + reattached.size(); }
   /// "ok", "degraded", "recovered" (lost, then re-attached to the same map), "suspect" (the
   /// calibration, see calibration_suspect) or "lost".
   std::string verdict() const;
