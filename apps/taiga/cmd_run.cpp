@@ -66,7 +66,7 @@ void printHealth(const pipeline::HealthReport& h) {
   for (const pipeline::Reattachment& r : h.reattached)
     fmt::print(
         "           map segment {} re-attached to the map at {:.1f} s: {:.2f} m / {:.2f} deg from "
-        "dead reckoning, {:.0f} % of its points on the map\n",
+        "dead reckoning, {:.0f} % of its points above the ground on the map\n",
         r.segment, r.t_s, r.correction_m, r.correction_deg, 100.0 * r.overlap);
   if (h.trackLost())
     fmt::print(

@@ -62,16 +62,17 @@ std::size_t getArray(std::string_view bytes, std::size_t offset, std::size_t n,
 
 KeyframeFileHeader decodeHeader(std::string_view bytes, std::string_view source_name) {
   if (bytes.size() < kHeaderBytes)
-    throw InputError(fmt::format("{}: not a taiga keyframe file: {} bytes, shorter than the {}-byte "
-                                 "header (truncated?)",
-                                 source_name, bytes.size(), kHeaderBytes));
+    throw InputError(
+        fmt::format("{}: not a taiga keyframe file: {} bytes, shorter than the {}-byte "
+                    "header (truncated?)",
+                    source_name, bytes.size(), kHeaderBytes));
   if (bytes.substr(0, kMagic.size()) != kMagic)
     throw InputError(fmt::format("{}: not a taiga keyframe file: it does not start with '{}'",
                                  source_name, kMagic));
   const auto version = get<std::uint32_t>(bytes, 8);
   if (version != kVersion)
-    throw InputError(fmt::format("{}: keyframe file version {}, expected {}", source_name, version,
-                                 kVersion));
+    throw InputError(
+        fmt::format("{}: keyframe file version {}, expected {}", source_name, version, kVersion));
   KeyframeFileHeader header;
   header.channels = get<std::uint32_t>(bytes, 12);
   header.id = get<std::uint64_t>(bytes, 16);
@@ -180,7 +181,8 @@ KeyframeFileHeader readKeyframeHeader(const std::filesystem::path& path) {
   const KeyframeFileHeader header = decodeHeader(bytes, path.string());
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) throw InputError(fmt::format("{}: cannot read its size: {}", path.string(), ec.message()));
+  if (ec)
+    throw InputError(fmt::format("{}: cannot read its size: {}", path.string(), ec.message()));
   checkSize(header, size, path.string());
   return header;
 }

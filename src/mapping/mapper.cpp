@@ -25,9 +25,9 @@ void Mapper::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body
   const std::size_t index = graph_.addKeyframe(T_odom_body, segment);
   if (index != id) throw std::logic_error("Mapper: keyframes must arrive in id order");
   keyframe_times_s_.push_back(t_s);
-  if (index == 0) attached_segments_.insert(segment);
+  if (index == 0) first_segment_ = segment;
   if (gnss_ && gnss_->afterKeyframe(graph_, keyframe_times_s_)) graph_.optimize();
-  if (!attached(index)) {
+  if (segment != first_segment_ && linking(segment, index)) {
     if (config_.relocalization) tryRelocalization(index, t_s);
     return;
   }
@@ -57,14 +57,29 @@ std::optional<GnssFusionReport> Mapper::gnssReport() const {
 
 std::vector<std::uint64_t> Mapper::reattachedSegments() const {
   std::vector<std::uint64_t> out;
-  for (const RelocalizationRecord& r : relocalizations_)
-    if (r.attempt.accepted) out.push_back(r.segment);
+  for (const auto& [segment, links] : links_) out.push_back(segment);
   return out;
+}
+
+bool Mapper::attached(std::size_t keyframe) const {
+  const std::uint64_t segment = graph_.segment(keyframe);
+  return segment == first_segment_ || links_.contains(segment);
+}
+
+bool Mapper::linking(std::uint64_t segment, std::size_t current) const {
+  const auto links = links_.find(segment);
+  if (links == links_.end()) return true;  // not attached yet
+  return links->second.count < kSegmentLinks &&
+         current - links->second.first_keyframe < kSegmentLinkKeyframes;
 }
 
 void Mapper::tryRelocalization(std::size_t current, double t_s) {
   if (last_relocalization_s_ && t_s - *last_relocalization_s_ < config_.loop_min_interval_s) return;
-  const Attached on_map = [this](std::size_t k) { return attached(k); };
+  const std::uint64_t segment = graph_.segment(current);
+  // The map the segment is searched in: attached keyframes of the other segments.
+  const Attached on_map = [this, segment](std::size_t k) {
+    return graph_.segment(k) != segment && attached(k);
+  };
   const std::optional<std::size_t> candidate =
       findRelocalizationCandidate(graph_, current, on_map, config_);
   if (!candidate) return;
@@ -77,12 +92,16 @@ void Mapper::tryRelocalization(std::size_t current, double t_s) {
   if (record.attempt.accepted) {
     record.chi2 = graph_.addLoopIfConsistent(record.attempt.link, config_.loop_max_chi2);
     if (record.chi2 <= config_.loop_max_chi2) {
-      attached_segments_.insert(record.segment);
+      const auto [links, first] =
+          links_.try_emplace(segment, SegmentLinks{.first_keyframe = current});
+      ++links->second.count;
       logger().info(
-          "map segment {} re-attached at keyframe {} to keyframe {}: moved {:.2f} m / {:.2f} deg "
-          "from dead reckoning, {:.0f} % of its points on the map",
-          record.segment, current, *candidate, record.attempt.correction_m,
-          record.attempt.correction_deg, 100.0 * record.attempt.overlap);
+          "map segment {} {} at keyframe {} to keyframe {}: moved {:.2f} m / {:.2f} deg from "
+          "{}, {:.0f} % of its points above the ground on the map ({:.0f} ms)",
+          record.segment, first ? "re-attached" : "tied again", current, *candidate,
+          record.attempt.correction_m, record.attempt.correction_deg,
+          first ? "dead reckoning" : "the graph", 100.0 * record.attempt.overlap,
+          record.attempt.search_ms);
     } else {
       record.attempt.accepted = false;
       record.attempt.note = fmt::format("inconsistent with the graph: chi2 {:.1f} above {:.1f}",
@@ -90,8 +109,8 @@ void Mapper::tryRelocalization(std::size_t current, double t_s) {
     }
   }
   if (!record.attempt.accepted)
-    logger().debug("map segment {} not re-attached at keyframe {}: {}", record.segment, current,
-                   record.attempt.note);
+    logger().debug("map segment {} not re-attached at keyframe {} ({:.0f} ms): {}", record.segment,
+                   current, record.attempt.search_ms, record.attempt.note);
   relocalizations_.push_back(std::move(record));
 }
 

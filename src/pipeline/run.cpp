@@ -198,9 +198,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   summary.wall_time_s = secondsSince(wall_start);
   scan_log.fillSummary(summary);
   summary.health = health.finish();
+  std::vector<Reattachment>& reattached = summary.health.reattached;
   for (const mapping::RelocalizationRecord& r : mapper.relocalizationAttempts())
-    if (r.attempt.accepted)
-      summary.health.reattached.push_back(
+    if (r.attempt.accepted && (reattached.empty() || reattached.back().segment != r.segment))
+      reattached.push_back(  // the first link of each segment
           {r.segment, r.t_s, r.attempt.correction_m, r.attempt.correction_deg, r.attempt.overlap});
   if (trajectories.odometry().empty())
     throw InputError(fmt::format(

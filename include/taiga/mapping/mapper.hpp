@@ -11,9 +11,9 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <thread>
 #include <variant>
 #include <vector>
@@ -80,15 +80,19 @@ class Mapper {
   const std::vector<RelocalizationRecord>& relocalizationAttempts() const {
     return relocalizations_;
   }
-  /// Segments that were re-attached to the map, in order.
+  /// Segments that were re-attached to the map, in order (accepted attempts: the first link of
+  /// each, and up to kSegmentLinks - 1 more).
   std::vector<std::uint64_t> reattachedSegments() const;
 
  private:
   void tryLoopClosure(std::size_t current, double t_s);
   void tryRelocalization(std::size_t current, double t_s);
-  bool attached(std::size_t keyframe) const {
-    return attached_segments_.contains(graph_.segment(keyframe));
-  }
+  /// Whether the keyframe's segment is the first or re-attached.
+  bool attached(std::size_t keyframe) const;
+  /// Whether a later segment still looks for links to the map rather than loops: until it is
+  /// attached, and then for more links (one registration's heading error would swing the whole
+  /// segment about it) within kSegmentLinkKeyframes of the first.
+  bool linking(std::uint64_t segment, std::size_t current) const;
 
   MappingConfig config_;
   OdometryConfig odometry_;
@@ -99,7 +103,14 @@ class Mapper {
   std::optional<GnssFusion> gnss_;
   std::optional<double> last_attempt_s_;
   std::vector<LoopRecord> attempts_;
-  std::set<std::uint64_t> attached_segments_;
+  static constexpr int kSegmentLinks = 3;
+  static constexpr std::size_t kSegmentLinkKeyframes = 20;
+  struct SegmentLinks {
+    std::size_t first_keyframe = 0;
+    int count = 0;
+  };
+  std::uint64_t first_segment_ = 0;
+  std::map<std::uint64_t, SegmentLinks> links_;  ///< of the re-attached segments
   std::optional<double> last_relocalization_s_;
   std::vector<RelocalizationRecord> relocalizations_;
 };

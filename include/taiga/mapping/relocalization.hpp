@@ -12,8 +12,9 @@
 //              keyframe's registration cloud over +-relocalization_search_deg of heading and
 //              +-relocalization_search_m of horizontal position in the candidate's submap (its
 //              attached neighbours); its best distinct starts refined by NDT, coarse to fine;
-//   accept:    the best refinement by overlap (share of the points within voxel_size_m of the
-//              submap) converged, with an overlap of at least kMinOverlap, clearly better than
+//   accept:    the best refinement by overlap (share of the points above the ground within
+//              voxel_size_m of the submap: ground lies near other ground at almost any pose)
+//              converged, with an overlap of at least kMinOverlap, clearly better than
 //              every distinct rival (a forest has look-alike places: a near tie is refused, and
 //              the next keyframe tries again). Not the fitness, as loops do: the keyframe may
 //              stand metres from the submap's keyframes and see what they did not.
@@ -44,6 +45,7 @@ struct RelocalizationAttempt {
   double fitness_m2 = 0.0;
   double correction_m = 0.0;    ///< how far it moves the current keyframe from dead reckoning
   double correction_deg = 0.0;  ///< and how far it turns it
+  double search_ms = 0.0;       ///< wall time of the search and the refinements
   RelativePose link;            ///< from = candidate, to = current
 };
 

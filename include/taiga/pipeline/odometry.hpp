@@ -135,10 +135,11 @@ class Odometry {
  private:
   std::optional<ScanOutcome> processScan(const io::Scan& scan);
   ScanOutcome firstScanOutcome(FirstScan&& first);
-  /// Registration to the local map, from the prediction and, without an IMU, when that looks
-  /// wrong, from the wide basin's other starts too.
+  /// Registration to the local map of the scan ending at t_s, from the prediction and, when
+  /// that looks wrong without an IMU or has dead-reckoned for long with one, from the wide
+  /// basin's other starts too.
   registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
-                                                 const lie::SE3& guess_T_odom_body);
+                                                 const lie::SE3& guess_T_odom_body, double t_s);
   /// One registration from one guess, with its fitness.
   registration::RegistrationResult alignToMap(const std::vector<Eigen::Vector3d>& source,
                                               const lie::SE3& guess_T_odom_body) const;
@@ -152,7 +153,10 @@ class Odometry {
   std::unique_ptr<MotionPrior> motion_;
   LocalMap local_map_;
   std::unique_ptr<HealthMonitor> health_;
-  std::unique_ptr<WideBasin> wide_basin_;  ///< lidar-only
+  /// Without an IMU whenever the registration looks poor; with one after
+  /// kImuBlindBeforeWideBasin_s without an ok scan.
+  std::unique_ptr<WideBasin> wide_basin_;
+  static constexpr double kImuBlindBeforeWideBasin_s = 1.0;
   std::uint64_t map_segment_ = 0;
   std::optional<lie::SE3> last_keyframe_T_odom_body_;
   std::uint64_t keyframes_made_ = 0;
