@@ -71,7 +71,8 @@ void printHealth(const pipeline::HealthReport& h) {
   if (h.trackLost())
     fmt::print(
         "           the track was lost and not re-attached: the trajectory and map after it are "
-        "not tied to those before it (scans.csv marks every scan; exit code 3)\n");
+        "not tied to those before it (scans.csv marks every scan, map_segment_N.las holds what "
+        "is not in map.las; exit code 3)\n");
 }
 
 void printCalibration(const pipeline::CalibrationRunReport& c) {

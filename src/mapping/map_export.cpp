@@ -148,6 +148,7 @@ MapExportSummary exportMap(const KeyframeStore& store,
   MapExportSummary summary;
   bool has_times = false, has_intensities = false, has_rings = false;
   for (std::uint64_t id = 0; id < store.size(); ++id) {
+    if (options.keep && !options.keep(id)) continue;
     const PointCloud cloud_out = toOutputFrame(
         store.load(id), options.T_out_map * Eigen::Affine3d(poses_T_map_body[id].matrix()));
     summary.points_read += cloud_out.size();

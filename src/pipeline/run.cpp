@@ -7,6 +7,7 @@
 #include <chrono>
 #include <deque>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include "recording_feed.hpp"
@@ -157,6 +158,30 @@ CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording,
   return report;
 }
 
+/// map.las from the keyframes on the map; a segment that was lost and never re-attached lies
+/// where dead reckoning put it, so its keyframes go to map_segment_N.las instead of corrupting
+/// the map. Returns the points in map.las.
+std::uint64_t exportMaps(const mapping::KeyframeStore& store, const mapping::Mapper& mapper,
+                         const std::filesystem::path& out, const RunOptions& options) {
+  const mapping::PoseGraph& graph = mapper.graph();
+  std::set<std::uint64_t> detached;
+  for (std::size_t k = 0; k < graph.size(); ++k)
+    if (!mapper.attached(k)) detached.insert(graph.segment(k));
+  const mapping::MapExportOptions map_options{.voxel_m = options.map_voxel_m,
+                                              .write_ply = options.write_ply};
+  for (const std::uint64_t segment : detached) {
+    mapping::MapExportOptions segment_options = map_options;
+    segment_options.keep = [&](std::uint64_t id) { return graph.segment(id) == segment; };
+    mapping::exportMap(store, graph.poses(), out / fmt::format("map_segment_{}.las", segment),
+                       segment_options);
+  }
+  mapping::MapExportOptions attached_options = map_options;
+  if (!detached.empty())
+    attached_options.keep = [&](std::uint64_t id) { return mapper.attached(id); };
+  return mapping::exportMap(store, graph.poses(), out / "map.las", attached_options)
+      .points_written;
+}
+
 }  // namespace
 
 RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& configured,
@@ -214,10 +239,7 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   io::writeTum(out / "keyframes.tum", slam.keyframes().trajectory());
   const auto export_start = Clock::now();
   const std::vector<lie::SE3>& keyframe_poses = mapper.graph().poses();
-  summary.map_points =
-      mapping::exportMap(slam.keyframes(), keyframe_poses, out / "map.las",
-                         {.voxel_m = options.map_voxel_m, .write_ply = options.write_ply})
-          .points_written;
+  summary.map_points = exportMaps(slam.keyframes(), mapper, out, options);
   summary.map_export_s = secondsSince(export_start);
   gnss.writeOnline(out / "georef");
   if (!gnss.input().fixes.empty())

@@ -111,5 +111,22 @@ TEST(MapExport, GlobalVoxelFilterKeepsOnePointPerVoxelNearestItsCentre) {
   EXPECT_THROW(exportMap(f.store, {}, las), std::invalid_argument);
 }
 
+// A run's map segment that was never re-attached goes to a file of its own: `keep` selects the
+// keyframes, with and without decimation.
+TEST(MapExport, KeepSelectsTheKeyframes) {
+  StoreFixture f;
+  const auto las = f.dir.file("map.las");
+  const auto odd = [](std::uint64_t id) { return id % 2 == 1; };
+  for (const double voxel_m : {0.0, 0.005}) {
+    const MapExportSummary summary =
+        exportMap(f.store, f.poses, las, {.voxel_m = voxel_m, .keep = odd});
+    EXPECT_EQ(summary.keyframes, 2u);
+    EXPECT_EQ(summary.points_written, 100u);
+    std::vector<std::uint16_t> ids;
+    io::LasReader(las).readStrided(1, &ids);
+    EXPECT_EQ(std::set<std::uint16_t>(ids.begin(), ids.end()), (std::set<std::uint16_t>{1, 3}));
+  }
+}
+
 }  // namespace
 }  // namespace taiga::mapping

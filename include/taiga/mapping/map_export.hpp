@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,8 @@ struct MapExportOptions {
   /// the map frame).
   Eigen::Affine3d T_out_map = Eigen::Affine3d::Identity();
   std::string wkt;  ///< OGC WKT of the output frame for the LAS header; empty: local coordinates
+  /// Which keyframes (by id) to export; empty: all (e.g. one map segment of a run).
+  std::function<bool(std::uint64_t id)> keep;
 };
 
 struct MapExportSummary {

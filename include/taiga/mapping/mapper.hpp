@@ -80,6 +80,8 @@ class Mapper {
   const std::vector<RelocalizationRecord>& relocalizationAttempts() const {
     return relocalizations_;
   }
+  /// Whether the keyframe's segment is the first or re-attached.
+  bool attached(std::size_t keyframe) const;
   /// Segments that were re-attached to the map, in order (accepted attempts: the first link of
   /// each, and up to kSegmentLinks - 1 more).
   std::vector<std::uint64_t> reattachedSegments() const;
@@ -87,8 +89,6 @@ class Mapper {
  private:
   void tryLoopClosure(std::size_t current, double t_s);
   void tryRelocalization(std::size_t current, double t_s);
-  /// Whether the keyframe's segment is the first or re-attached.
-  bool attached(std::size_t keyframe) const;
   /// Whether a later segment still looks for links to the map rather than loops: until it is
   /// attached, and then for more links (one registration's heading error would swing the whole
   /// segment about it) within kSegmentLinkKeyframes of the first.
