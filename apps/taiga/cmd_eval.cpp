@@ -42,15 +42,16 @@ struct EvalOptions {
 // trajectory's alignment, against the regenerated scene.
 eval::MapSharpness mapSharpness(const EvalOptions& options, const eval::AlignmentTransform& T) {
   io::LasReader reader(options.map);
-  const std::uint64_t stride =
-      std::max<std::uint64_t>(1, (reader.pointCount() + options.map_points - 1) / options.map_points);
+  const std::uint64_t stride = std::max<std::uint64_t>(
+      1, (reader.pointCount() + options.map_points - 1) / options.map_points);
   const PointCloud sample = reader.readStrided(stride);
   const sim::Simulation simulation = simulationOfRecording(options.scene);
   const sim::Scene& scene = simulation.scene();
-  return eval::computeMapSharpness(
-      sample.positions, reader.pointCount(), T,
-      [&](const Eigen::Vector3d& p_ref, double max_m) { return scene.distanceToSurface(p_ref, max_m); },
-      {.cap_m = options.map_cap_m, .max_points = options.map_points});
+  return eval::computeMapSharpness(sample.positions, reader.pointCount(), T,
+                                   [&](const Eigen::Vector3d& p_ref, double max_m) {
+                                     return scene.distanceToSurface(p_ref, max_m);
+                                   },
+                                   {.cap_m = options.map_cap_m, .max_points = options.map_points});
 }
 
 int runEval(const EvalOptions& options) {
@@ -76,15 +77,28 @@ int runEval(const EvalOptions& options) {
   }
   if (!options.map.empty() || !options.scene.empty()) {
     if (options.map.empty() || options.scene.empty())
-      throw InputError("--map and --scene go together: the map and the simulated recording whose "
-                       "scene it is scored against");
+      throw InputError(
+          "--map and --scene go together: the map and the simulated recording whose "
+          "scene it is scored against");
     report.map_file = options.map;
     report.scene_dir = options.scene;
     report.map_sharpness = mapSharpness(options, report.result.transform);
   }
   if (!options.scans.empty()) {
     report.scans_file = options.scans;
-    report.ape_by_status = eval::apeByStatus(report.result, eval::readScanStatuses(options.scans));
+    const std::vector<eval::ScanStatusAt> scans = eval::readScanStatuses(options.scans);
+    report.ape_by_status = eval::apeByStatus(report.result, scans);
+    const Trajectory ok = eval::posesWithStatus(est, scans, "ok");
+    if (report.ape_by_status->size() > 1 && ok.size() >= 3) {
+      try {
+        const eval::EvalResult alone = eval::evaluate(ok, ref, o);
+        report.ok_self_aligned =
+            eval::StatusApe{"ok", alone.ape.translation_error_m.size(),
+                            alone.ape.translation_m.rmse, alone.ape.translation_m.max};
+      } catch (const InputError&) {
+        // Too few or too straight a stretch of ok poses to align alone: the split above stands.
+      }
+    }
   }
   if (!options.timing.empty()) {
     report.timing_file = options.timing;
@@ -161,12 +175,14 @@ Command addEvalCommand(CLI::App& tool) {
   parser->add_option("--distance-bin-m", options->distance_bin_m, "Histogram bin width, m")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  parser->add_option("--map", options->map,
-                     "map.las of the run: score its distance to the true scene (with --scene)")
+  parser
+      ->add_option("--map", options->map,
+                   "map.las of the run: score its distance to the true scene (with --scene)")
       ->check(CLI::ExistingFile);
-  parser->add_option("--scene", options->scene,
-                     "Directory written by taiga simulate (scenario.yaml, scene.json) whose scene "
-                     "the map is scored against")
+  parser
+      ->add_option("--scene", options->scene,
+                   "Directory written by taiga simulate (scenario.yaml, scene.json) whose scene "
+                   "the map is scored against")
       ->check(CLI::ExistingDirectory);
   parser->add_option("--map-cap", options->map_cap_m, "Map distances are capped here, m")
       ->check(CLI::PositiveNumber)

@@ -78,17 +78,35 @@ std::vector<ScanStatusAt> readScanStatuses(const std::filesystem::path& path) {
   return scans;
 }
 
+namespace {
+
+/// The first scan ending at or after t_s (a microsecond of slack for printed stamps), if any.
+const ScanStatusAt* scanOf(double t_s, const std::vector<ScanStatusAt>& scans) {
+  const auto scan = std::lower_bound(scans.begin(), scans.end(), t_s - 1e-6,
+                                     [](const ScanStatusAt& s, double t) { return s.t_s < t; });
+  return scan == scans.end() ? nullptr : &*scan;
+}
+
+}  // namespace
+
+Trajectory posesWithStatus(const Trajectory& estimate, const std::vector<ScanStatusAt>& scans,
+                           const std::string& status) {
+  Trajectory out;
+  for (const StampedPose& p : estimate.poses()) {
+    const ScanStatusAt* scan = scanOf(p.t_s, scans);
+    if (scan && scan->status == status) out.append(p.t_s, p.pose);
+  }
+  return out;
+}
+
 std::vector<StatusApe> apeByStatus(const EvalResult& result,
                                    const std::vector<ScanStatusAt>& scans) {
   const std::vector<std::string> order = {"ok", "degraded", "lost"};
   std::vector<std::vector<double>> errors(order.size());
   const std::vector<double>& e = result.ape.translation_error_m;
   for (std::size_t i = 0; i < e.size() && i < result.pairs.est.size(); ++i) {
-    const double t_s = result.pairs.est[i].t_s;
-    // The first scan ending at or after t_s (a microsecond of slack for printed stamps).
-    const auto scan = std::lower_bound(scans.begin(), scans.end(), t_s - 1e-6,
-                                       [](const ScanStatusAt& s, double t) { return s.t_s < t; });
-    if (scan == scans.end()) continue;
+    const ScanStatusAt* scan = scanOf(result.pairs.est[i].t_s, scans);
+    if (!scan) continue;
     const auto k = std::find(order.begin(), order.end(), scan->status);
     if (k != order.end()) errors[static_cast<std::size_t>(k - order.begin())].push_back(e[i]);
   }

@@ -63,19 +63,18 @@ std::string formatEvalJson(const EvalReport& report) {
     for (const StatusApe& s : *report.ape_by_status)
       by_status[s.status] = {{"poses", s.poses}, {"rmse_m", s.rmse_m}, {"max_m", s.max_m}};
     j["ape_by_status"] = {{"scans", report.scans_file}, {"statuses", by_status}};
+    if (const std::optional<StatusApe>& ok = report.ok_self_aligned)
+      j["ape_by_status"]["ok_aligned_alone"] = {
+          {"poses", ok->poses}, {"rmse_m", ok->rmse_m}, {"max_m", ok->max_m}};
   }
   if (report.map_sharpness) {
     const MapSharpness& m = *report.map_sharpness;
-    j["map_sharpness"] = {{"map", report.map_file},
-                          {"scene", report.scene_dir},
-                          {"map_points", m.map_points},
-                          {"points_scored", m.points_scored},
-                          {"cap_m", m.cap_m},
-                          {"rms_m", m.rms_m},
-                          {"mean_m", m.mean_m},
-                          {"median_m", m.median_m},
-                          {"p95_m", m.p95_m},
-                          {"fraction_beyond_cap", m.fraction_beyond_cap}};
+    j["map_sharpness"] = {
+        {"map", report.map_file},     {"scene", report.scene_dir},
+        {"map_points", m.map_points}, {"points_scored", m.points_scored},
+        {"cap_m", m.cap_m},           {"rms_m", m.rms_m},
+        {"mean_m", m.mean_m},         {"median_m", m.median_m},
+        {"p95_m", m.p95_m},           {"fraction_beyond_cap", m.fraction_beyond_cap}};
   }
   return detail::dump(j);
 }

@@ -84,18 +84,22 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
   if (report.map_sharpness) {
     const MapSharpness& m = *report.map_sharpness;
     rows.push_back({"Map sharpness RMS (m)",
-                    fmt::format("{:.6f} ({} of {} points of {}, distances capped at {} m)",
-                                m.rms_m, m.points_scored, m.map_points, report.map_file, m.cap_m)});
-    rows.push_back({"Map distance to true surfaces (m)",
-                    fmt::format("mean {:.6f}  median {:.6f}  p95 {:.6f}  beyond {} m: {:.3f} %",
-                                m.mean_m, m.median_m, m.p95_m, m.cap_m,
-                                100.0 * m.fraction_beyond_cap)});
+                    fmt::format("{:.6f} ({} of {} points of {}, distances capped at {} m)", m.rms_m,
+                                m.points_scored, m.map_points, report.map_file, m.cap_m)});
+    rows.push_back(
+        {"Map distance to true surfaces (m)",
+         fmt::format("mean {:.6f}  median {:.6f}  p95 {:.6f}  beyond {} m: {:.3f} %", m.mean_m,
+                     m.median_m, m.p95_m, m.cap_m, 100.0 * m.fraction_beyond_cap)});
   }
   if (report.ape_by_status) {
     for (const StatusApe& s : *report.ape_by_status)
       rows.push_back({fmt::format("APE of {} scans (m)", s.status),
                       fmt::format("rmse {:.6f}  max {:.6f}  ({} poses, {})", s.rmse_m, s.max_m,
                                   s.poses, report.scans_file)});
+    if (const std::optional<StatusApe>& ok = report.ok_self_aligned)
+      rows.push_back(
+          {"APE of ok scans, aligned alone (m)",
+           fmt::format("rmse {:.6f}  max {:.6f}  ({} poses)", ok->rmse_m, ok->max_m, ok->poses)});
   }
   if (report.timing) {
     const TimingStatistics& t = *report.timing;

@@ -54,6 +54,29 @@ TEST(HealthSplit, GroupsEachPoseWithTheScanItLeadsUpTo) {
   EXPECT_EQ(split[2].poses, 1u);  // 3.5 s lies after the last scan: left out
 }
 
+// The ok poses evaluated alone: a lost stretch far off pulls the alignment of all poses, so the ok
+// poses look wrong among them; aligned on themselves they are exact.
+TEST(HealthSplit, TheOkPosesAlignedAloneAreNotPulledByALostStretch) {
+  Trajectory truth, estimate;
+  std::vector<ScanStatusAt> scans;
+  for (int k = 0; k < 40; ++k) {
+    const double t_s = 0.1 * k;
+    const lie::SE3 T(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.05 * k),
+                     Eigen::Vector3d(k, 0.02 * k * k, 0.1 * std::sin(k)));
+    truth.append(t_s, T);
+    const bool lost = k >= 25 && k < 35;  // 10 poses 3 m off
+    estimate.append(t_s, lost ? lie::SE3(lie::SO3(), Eigen::Vector3d(0, 3, 0)) * T : T);
+    scans.push_back({t_s, lost ? "lost" : "ok"});
+  }
+  const Trajectory ok = posesWithStatus(estimate, scans, "ok");
+  EXPECT_EQ(ok.size(), 30u);
+  const std::vector<StatusApe> pulled = apeByStatus(evaluate(estimate, truth, {}), scans);
+  ASSERT_EQ(pulled.front().status, "ok");
+  EXPECT_GT(pulled.front().rmse_m, 0.1);
+  EXPECT_LT(evaluate(ok, truth, {}).ape.translation_m.max, 1e-9);
+  EXPECT_EQ(posesWithStatus(estimate, scans, "lost").size(), 10u);
+}
+
 TEST(HealthSplit, BadFilesAreNamedWithTheLine) {
   const test::TempDir dir;
   const auto old = dir.write("old.csv", "t_s,scan,lidar_factor\n1.0,0,used\n");

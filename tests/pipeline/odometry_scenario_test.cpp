@@ -551,17 +551,9 @@ TEST(OdometryScenario, ATwoSecondStandStillInAnOpenFieldIsBridgedAndSaid) {
 // The poses of the scans the run called ok, evaluated alone (aligned on themselves): the map
 // where the run says it is on track, whatever the flagged scans did.
 eval::EvalResult evaluateOkScans(const std::filesystem::path& run_dir, const Trajectory& truth) {
-  const std::vector<eval::ScanStatusAt> statuses = eval::readScanStatuses(run_dir / "scans.csv");
-  const Trajectory estimate = io::readTum(run_dir / "trajectory.tum");
-  Trajectory ok;
-  std::size_t s = 0;
-  for (const StampedPose& p : estimate.poses()) {
-    while (s < statuses.size() && statuses[s].t_s < p.t_s - 1e-6) ++s;
-    if (s < statuses.size() && std::abs(statuses[s].t_s - p.t_s) < 1e-6 &&
-        statuses[s].status == "ok")
-      ok.append(p.t_s, p.pose);
-  }
-  return eval::evaluate(ok, truth, {});
+  return eval::evaluate(eval::posesWithStatus(io::readTum(run_dir / "trajectory.tum"),
+                                              eval::readScanStatuses(run_dir / "scans.csv"), "ok"),
+                        truth, {});
 }
 
 // The lidar blind for 10 s (every packet lost: no scans at all) in a `harsh` handheld walk.

@@ -34,4 +34,10 @@ struct StatusApe {
 std::vector<StatusApe> apeByStatus(const EvalResult& result,
                                    const std::vector<ScanStatusAt>& scans);
 
+/// The poses of `estimate` whose scan (as above) has `status`: e.g. the ok ones, to evaluate
+/// where the run says it was on track with an alignment of their own (the lost poses of a long
+/// stretch otherwise pull the alignment of all poses, and the ok ones look worse than they are).
+Trajectory posesWithStatus(const Trajectory& estimate, const std::vector<ScanStatusAt>& scans,
+                           const std::string& status);
+
 }  // namespace taiga::eval

@@ -25,6 +25,8 @@ struct EvalReport {
   std::string map_file, scene_dir;
   /// `--scans RUN/scans.csv`: the APE by the health status of each pose's scan.
   std::optional<std::vector<StatusApe>> ape_by_status;
+  /// The ok scans' poses evaluated alone (their own alignment), when some scans were not ok.
+  std::optional<StatusApe> ok_self_aligned;
   std::string scans_file;
 };
 
