@@ -14,6 +14,7 @@
 #include "taiga/eval/report.hpp"
 #include "taiga/io/las_reader.hpp"
 #include "taiga/io/trajectory_io.hpp"
+#include "taiga/trees/tree_files.hpp"
 
 namespace taiga::app {
 namespace {
@@ -36,6 +37,8 @@ struct EvalOptions {
   std::string map, scene;
   double map_cap_m = 1.0;
   std::size_t map_points = 200000;
+  std::string trees, ref_trees;
+  eval::TreeAccuracyOptions tree_options;
 };
 
 // Map sharpness: an evenly strided subsample of the map, moved into the truth frame with the
@@ -83,6 +86,17 @@ int runEval(const EvalOptions& options) {
     report.map_file = options.map;
     report.scene_dir = options.scene;
     report.map_sharpness = mapSharpness(options, report.result.transform);
+  }
+  if (!options.trees.empty() || !options.ref_trees.empty()) {
+    if (options.trees.empty() || options.ref_trees.empty())
+      throw InputError("--trees and --ref-trees go together: a tree list and the reference one");
+    report.trees_file = options.trees;
+    report.ref_trees_file = options.ref_trees;
+    std::vector<Eigen::Vector3d> path_m;
+    for (const StampedPose& pose : ref) path_m.push_back(pose.pose.translation());
+    report.trees = eval::evaluateTrees(trees::readTreesCsv(options.trees),
+                                       trees::readTreesCsv(options.ref_trees),
+                                       report.result.transform, path_m, options.tree_options);
   }
   if (!options.scans.empty()) {
     report.scans_file = options.scans;
@@ -190,6 +204,19 @@ Command addEvalCommand(CLI::App& tool) {
   parser->add_option("--map-points", options->map_points, "Score at most this many map points")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  parser->add_option("--trees", options->trees,
+                     "A tree list (trees.csv of `taiga trees`) to score against --ref-trees");
+  parser->add_option("--ref-trees", options->ref_trees,
+                     "The reference tree list (e.g. a simulated recording's trees.csv)");
+  parser->add_option("--trees-radius", options->tree_options.max_path_distance_m,
+                     "Trees within this distance of the reference path are counted, m")
+      ->check(CLI::PositiveNumber);
+  parser->add_option("--trees-min-dbh", options->tree_options.min_dbh_m,
+                     "Reference trees at least this thick are counted, m")
+      ->check(CLI::NonNegativeNumber);
+  parser->add_option("--trees-match", options->tree_options.match_m,
+                     "A stem and a reference tree match within this distance, m")
+      ->check(CLI::PositiveNumber);
   parser->add_flag("--json", options->json, "Print JSON instead of text");
   parser->add_flag("--markdown", options->markdown, "Print Markdown tables instead of text");
   return {parser, [options] { return runEval(*options); }, options};

@@ -34,7 +34,7 @@ int runTool(int argc, char** argv) {
       addSimulateCommand(tool), addInfoCommand(tool),   addExportCommand(tool),
       addRegisterCommand(tool), addRunCommand(tool),    addEvalCommand(tool),
       addCompareCommand(tool),  addGeorefCommand(tool), addConfigCommand(tool),
-      addExportMapCommand(tool), addCalibrateCommand(tool)};
+      addExportMapCommand(tool), addCalibrateCommand(tool), addTreesCommand(tool)};
 
   try {
     tool.parse(argc, argv);

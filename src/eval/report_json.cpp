@@ -76,6 +76,34 @@ std::string formatEvalJson(const EvalReport& report) {
         {"mean_m", m.mean_m},         {"median_m", m.median_m},
         {"p95_m", m.p95_m},           {"fraction_beyond_cap", m.fraction_beyond_cap}};
   }
+  if (report.trees) {
+    const TreeAccuracy& t = *report.trees;
+    auto classes = [](const std::vector<TreeClass>& list) {
+      json out = json::array();
+      for (const TreeClass& c : list)
+        out.push_back({{"label", c.label}, {"reference", c.reference}, {"detected", c.detected}});
+      return out;
+    };
+    j["trees"] = {{"trees", report.trees_file},
+                  {"ref_trees", report.ref_trees_file},
+                  {"match_m", t.options.match_m},
+                  {"min_dbh_m", t.options.min_dbh_m},
+                  {"max_path_distance_m", t.options.max_path_distance_m},
+                  {"reference", t.reference},
+                  {"detected", t.detected},
+                  {"estimated", t.estimated},
+                  {"false_stems", t.false_stems},
+                  {"recall", t.recall},
+                  {"commission", t.commission},
+                  {"dbh_rmse_m", t.dbh_rmse_m},
+                  {"dbh_bias_m", t.dbh_bias_m},
+                  {"position_rmse_m", t.position_rmse_m},
+                  {"height_rmse_m", t.height_rmse_m},
+                  {"height_bias_m", t.height_bias_m},
+                  {"overlap_ratio", t.overlap_ratio},
+                  {"by_dbh", classes(t.by_dbh)},
+                  {"by_distance", classes(t.by_distance)}};
+  }
   return detail::dump(j);
 }
 

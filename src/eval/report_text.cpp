@@ -91,6 +91,28 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
          fmt::format("mean {:.6f}  median {:.6f}  p95 {:.6f}  beyond {} m: {:.3f} %", m.mean_m,
                      m.median_m, m.p95_m, m.cap_m, 100.0 * m.fraction_beyond_cap)});
   }
+  if (report.trees) {
+    const TreeAccuracy& t = *report.trees;
+    rows.push_back({"Trees (detected / reference)",
+                    fmt::format("{} / {} (DBH >= {} cm, within {} m of the path; {} against {})",
+                                t.detected, t.reference, 100 * t.options.min_dbh_m,
+                                t.options.max_path_distance_m, report.trees_file,
+                                report.ref_trees_file)});
+    rows.push_back({"Tree detection rate (%)", fmt::format("{:.1f}", 100 * t.recall)});
+    rows.push_back({"Tree commission (%)",
+                    fmt::format("{:.1f} ({} of {} stems match no tree)", 100 * t.commission,
+                                t.false_stems, t.estimated)});
+    rows.push_back({"DBH error (cm)", fmt::format("rmse {:.2f}  bias {:+.2f}", 100 * t.dbh_rmse_m,
+                                                  100 * t.dbh_bias_m)});
+    rows.push_back({"Stem position RMSE (cm)", fmt::format("{:.2f}", 100 * t.position_rmse_m)});
+    rows.push_back({"Tree height error (m)",
+                    fmt::format("rmse {:.2f}  bias {:+.2f}", t.height_rmse_m, t.height_bias_m)});
+    rows.push_back({"Overlapping-tree ratio (%)", fmt::format("{:.1f}", 100 * t.overlap_ratio)});
+    for (const std::vector<TreeClass>* classes : {&t.by_dbh, &t.by_distance})
+      for (const TreeClass& c : *classes)
+        rows.push_back({fmt::format("  detected, {}", c.label),
+                        fmt::format("{} of {}", c.detected, c.reference)});
+  }
   if (report.ape_by_status) {
     for (const StatusApe& s : *report.ape_by_status)
       rows.push_back({fmt::format("APE of {} scans (m)", s.status),

@@ -188,4 +188,32 @@ void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& repo
   fmt::output_file(path.string()).print("{}\n", out.c_str());
 }
 
+GeorefGrid readGeorefGrid(const std::filesystem::path& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(fmt::format("{}: {}", path.string(), e.what()));
+  }
+  GeorefGrid grid;
+  try {
+    grid.epsg = root["epsg"].as<int>();
+    const YAML::Node rows = root["T_epsg_world"];
+    if (!rows || !rows.IsSequence() || rows.size() != 4)
+      throw InputError(fmt::format("{}: T_epsg_world: expected 4 rows", path.string()));
+    for (std::size_t r = 0; r < 4; ++r) {
+      if (!rows[r].IsSequence() || rows[r].size() != 4)
+        throw InputError(fmt::format("{}: T_epsg_world row {}: expected 4 numbers", path.string(), r));
+      for (std::size_t c = 0; c < 4; ++c) grid.T_epsg_world(r, c) = rows[r][c].as<double>();
+    }
+  } catch (const YAML::Exception& e) {
+    throw InputError(
+        fmt::format("{}: epsg and T_epsg_world expected (a georef.yaml of taiga): {}", path.string(),
+                    e.what()));
+  }
+  if (!grid.T_epsg_world.allFinite())
+    throw InputError(fmt::format("{}: T_epsg_world has non-finite values", path.string()));
+  return grid;
+}
+
 }  // namespace taiga::georef

@@ -119,6 +119,19 @@ void LasWriter::writeHeader() {
 }
 
 void LasWriter::append(const PointCloud& cloud, std::uint16_t source_id) {
+  appendRecords(cloud, {}, {}, source_id);
+}
+
+void LasWriter::append(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
+                       std::span<const std::uint16_t> source_ids) {
+  if (classifications.size() != cloud.size() || source_ids.size() != cloud.size())
+    throw std::logic_error("LasWriter::append: one classification and source ID per point");
+  appendRecords(cloud, classifications, source_ids, 0);
+}
+
+void LasWriter::appendRecords(const PointCloud& cloud,
+                              std::span<const std::uint8_t> classifications,
+                              std::span<const std::uint16_t> source_ids, std::uint16_t source_id) {
   if (closed_) throw std::logic_error("LasWriter::append after close");
   if (cloud.empty()) return;
   if (!offset_set_) {
@@ -144,10 +157,11 @@ void LasWriter::append(const PointCloud& cloud, std::uint16_t source_id) {
     records.put<std::uint16_t>(static_cast<std::uint16_t>(std::clamp(std::round(intensity), 0.0f, 65535.0f)));
     records.put<std::uint8_t>(0x11);  // return 1 of 1
     records.put<std::uint8_t>(0);     // classification flags, scanner channel, scan direction, edge
-    records.put<std::uint8_t>(options_.classification);
+    records.put<std::uint8_t>(classifications.empty() ? options_.classification
+                                                      : classifications[i]);
     records.put<std::uint8_t>(cloud.hasRings() ? static_cast<std::uint8_t>(std::min<int>(cloud.rings[i], 255)) : 0);
     records.put<std::int16_t>(0);  // scan angle
-    records.put<std::uint16_t>(source_id);
+    records.put<std::uint16_t>(source_ids.empty() ? source_id : source_ids[i]);
     records.put<double>(cloud.hasTimes() ? cloud.times_s[i] : 0.0);
   }
   out_.seekp(0, std::ios::end);

@@ -61,12 +61,16 @@ const char* speciesName(Species s) {
 
 void writeTreesCsv(const std::filesystem::path& path, const Scene& scene) {
   // Full precision ({} is the shortest text that reads back to the same double).
-  std::string text = "id,x_m,y_m,z_m,dbh_m,height_m,lean_deg,lean_azimuth_deg,species\n";
+  // x_bh_m, y_bh_m: the axis at breast height, where DBH is measured (lean and bow included).
+  std::string text =
+      "id,x_m,y_m,z_m,dbh_m,height_m,lean_deg,lean_azimuth_deg,species,x_bh_m,y_bh_m\n";
   std::size_t id = 0;
   for (const Tree& t : scene.trees()) {
-    text += fmt::format("{},{},{},{},{},{},{},{},{}\n", id++, t.base_world.x(), t.base_world.y(),
-                        t.base_world.z(), t.dbh_m, t.height_m, t.lean_rad * kDegPerRad,
-                        t.lean_azimuth_rad * kDegPerRad, speciesName(t.species));
+    const Eigen::Vector3d bh = t.axisAt(1.3);
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", id++, t.base_world.x(),
+                        t.base_world.y(), t.base_world.z(), t.dbh_m, t.height_m,
+                        t.lean_rad * kDegPerRad, t.lean_azimuth_rad * kDegPerRad,
+                        speciesName(t.species), bh.x(), bh.y());
   }
   writeText(path, text);
 }

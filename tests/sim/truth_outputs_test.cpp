@@ -68,11 +68,12 @@ TEST(TruthOutputs, TreesCsvHoldsEveryStemAtFullPrecision) {
   const auto rows = readCsv(dir.file("trees.csv"));
   ASSERT_EQ(rows.size(), simulation.scene().trees().size() + 1);
   EXPECT_EQ(rows[0], (std::vector<std::string>{"id", "x_m", "y_m", "z_m", "dbh_m", "height_m",
-                                                "lean_deg", "lean_azimuth_deg", "species"}));
+                                                "lean_deg", "lean_azimuth_deg", "species", "x_bh_m",
+                                                "y_bh_m"}));
   for (std::size_t i = 0; i < simulation.scene().trees().size(); ++i) {
     const Tree& tree = simulation.scene().trees()[i];
     const auto& row = rows[i + 1];
-    ASSERT_EQ(row.size(), 9u);
+    ASSERT_EQ(row.size(), 11u);
     EXPECT_EQ(std::stoul(row[0]), i);
     EXPECT_EQ(std::stod(row[1]), tree.base_world.x());
     EXPECT_EQ(std::stod(row[2]), tree.base_world.y());
@@ -81,6 +82,8 @@ TEST(TruthOutputs, TreesCsvHoldsEveryStemAtFullPrecision) {
     EXPECT_EQ(std::stod(row[5]), tree.height_m);
     EXPECT_NEAR(std::stod(row[6]), tree.lean_rad * kDegPerRad, 1e-12);
     EXPECT_TRUE(row[8] == "pine" || row[8] == "spruce" || row[8] == "birch") << row[8];
+    EXPECT_EQ(std::stod(row[9]), tree.axisAt(1.3).x());
+    EXPECT_EQ(std::stod(row[10]), tree.axisAt(1.3).y());
   }
 }
 

@@ -9,6 +9,7 @@
 #include "taiga/eval/health_split.hpp"
 #include "taiga/eval/map_sharpness.hpp"
 #include "taiga/eval/timing.hpp"
+#include "taiga/eval/tree_accuracy.hpp"
 
 namespace taiga::eval {
 
@@ -28,6 +29,9 @@ struct EvalReport {
   /// The ok scans' poses evaluated alone (their own alignment), when some scans were not ok.
   std::optional<StatusApe> ok_self_aligned;
   std::string scans_file;
+  /// `--trees TREES --ref-trees TREES`: the tree list against the reference one.
+  std::optional<TreeAccuracy> trees;
+  std::string trees_file, ref_trees_file;
 };
 
 /// Statistics with 6 decimals, as evo prints them.

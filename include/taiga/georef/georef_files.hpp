@@ -50,4 +50,12 @@ void writeGeoJson(const std::filesystem::path& path, const std::vector<GridPose>
                   const std::string& name);
 void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& report);
 
+/// The grid a georef.yaml places the world (map) frame in: its EPSG code and T_epsg_world.
+struct GeorefGrid {
+  int epsg = 0;
+  Eigen::Matrix4d T_epsg_world = Eigen::Matrix4d::Identity();
+};
+/// Reads `epsg` and `T_epsg_world` of a georef.yaml; InputError naming the file and the key.
+GeorefGrid readGeorefGrid(const std::filesystem::path& path);
+
 }  // namespace taiga::georef

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "taiga/core/point_cloud.hpp"
@@ -45,6 +46,10 @@ class LasWriter {
   /// to each point's point source ID. Throws InputError when a point does not fit the 32-bit
   /// integer range at the chosen scale and offset.
   void append(const PointCloud& cloud, std::uint16_t source_id = 0);
+  /// The same with a classification and a point source ID per point (e.g. ground and stem codes
+  /// and tree ids from `taiga trees`); both spans as long as the cloud.
+  void append(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
+              std::span<const std::uint16_t> source_ids);
   /// Writes the final header; also done by the destructor (which cannot report errors).
   void close();
 
@@ -53,6 +58,8 @@ class LasWriter {
 
  private:
   void writeHeader();
+  void appendRecords(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
+                     std::span<const std::uint16_t> source_ids, std::uint16_t source_id);
 
   std::filesystem::path path_;
   LasOptions options_;

@@ -1,0 +1,175 @@
+// taiga trees: the forest inventory of a map (docs/trees.md): ground, DTM, stems, DBH, a tree
+// list and a classified map, from a run directory or any LAS/PLY/PCD cloud.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "command.hpp"
+#include "taiga/core/errors.hpp"
+#include "taiga/geo/coordinates.hpp"
+#include "taiga/georef/georef_files.hpp"
+#include "taiga/io/cloud_files.hpp"
+#include "taiga/io/las_reader.hpp"
+#include "taiga/io/las_writer.hpp"
+#include "taiga/trees/inventory.hpp"
+#include "taiga/trees/tree_files.hpp"
+
+namespace taiga::app {
+namespace {
+namespace fs = std::filesystem;
+
+struct TreesOptions {
+  std::string input, out;
+  double dtm_cell_m = 0.5;
+  double min_dbh_m = 0.07;
+  double breast_height_m = 1.3;
+  int epsg = 0;
+  bool no_map = false;
+};
+
+std::string lowerExtension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+PointCloud readCloud(const fs::path& path) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".las") {
+    io::LasReader reader(path);
+    PointCloud cloud;
+    reader.read(0, reader.pointCount(), cloud);
+    return cloud;
+  }
+  if (ext == ".laz")
+    throw InputError(fmt::format(
+        "{}: LAZ (compressed LAS) is not read; decompress it first (e.g. `las2las` or `pdal "
+        "translate` to .las) or give a PLY or PCD",
+        path.string()));
+  if (ext == ".ply" || ext == ".pcd") {
+    io::DecodedPoints decoded = io::readPointCloudFile(path, 0.0);
+    if (decoded.dropped_invalid > 0)
+      fmt::print(stderr, "taiga trees: {}: {} points with NaN, infinite or zero coordinates skipped\n",
+                 path.string(), decoded.dropped_invalid);
+    return std::move(decoded.cloud);
+  }
+  throw InputError(fmt::format("{}: expected a .las, .ply or .pcd point cloud, or a run directory",
+                               path.string()));
+}
+
+// Points are shifted to a round offset near them, so projected coordinates (millions of metres)
+// do not cost precision or overflow the grids' integer cells.
+Eigen::Vector3d roundOffset(const std::vector<Eigen::Vector3d>& points_m) {
+  for (const Eigen::Vector3d& p : points_m)
+    if (p.allFinite()) return (p / 100.0).array().floor() * 100.0;
+  return Eigen::Vector3d::Zero();
+}
+
+int runTrees(const TreesOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const fs::path input = options.input;
+  const bool run_dir = fs::is_directory(input);
+  const fs::path map_path = run_dir ? input / "map.las" : input;
+  if (run_dir && !fs::exists(map_path))
+    throw InputError(fmt::format("{}: a directory without map.las (give a run directory of `taiga "
+                                 "run`, or a LAS/PLY/PCD file)",
+                                 input.string()));
+  const fs::path out = !options.out.empty() ? fs::path(options.out)
+                       : run_dir            ? input
+                                            : input.parent_path();
+  fs::create_directories(out.empty() ? "." : out);
+
+  PointCloud cloud = readCloud(map_path);
+  if (cloud.empty()) throw InputError(fmt::format("{}: the cloud has no points", map_path.string()));
+  const Eigen::Vector3d offset_m = roundOffset(cloud.positions);
+  std::vector<Eigen::Vector3d> local(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) local[i] = cloud.positions[i] - offset_m;
+
+  std::optional<trees::GridFrame> grid;
+  std::string wkt;
+  const fs::path georef_yaml = input / "georef" / "georef.yaml";
+  if (options.epsg > 0) {
+    // The cloud is already in the grid.
+    const geo::CoordinateConverter crs(options.epsg);
+    wkt = crs.wkt();
+    grid = trees::GridFrame{options.epsg, Eigen::Affine3d(Eigen::Translation3d(offset_m))};
+  } else if (run_dir && fs::exists(georef_yaml)) {
+    const georef::GeorefGrid g = georef::readGeorefGrid(georef_yaml);
+    grid = trees::GridFrame{g.epsg,
+                            Eigen::Affine3d(g.T_epsg_world) * Eigen::Translation3d(offset_m)};
+  }
+
+  trees::InventoryOptions io_options;
+  io_options.terrain.cell_m = options.dtm_cell_m;
+  io_options.stems.min_dbh_m = options.min_dbh_m;
+  io_options.stems.breast_height_m = options.breast_height_m;
+  const trees::Inventory inventory = trees::takeInventory(local, io_options);
+  const std::vector<trees::Stem>& stems = inventory.stems;
+
+  trees::writeTreesCsv(out / "trees.csv", stems, offset_m, grid);
+  trees::writeTreesGeoJson(out / "trees.geojson", stems, offset_m, grid);
+  trees::writeAsciiGrid(out / "dtm.asc", inventory.terrain, offset_m);
+  if (!options.no_map) {
+    const trees::PointLabels labels = trees::labelPoints(local, inventory, io_options.terrain);
+    io::LasWriter writer(out / "trees_map.las", {.wkt = wkt});
+    writer.append(cloud, labels.classification, labels.tree_id);
+    writer.close();
+  }
+
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::size_t good = 0, partial = 0;
+  for (const trees::Stem& s : stems) {
+    good += s.quality == trees::StemQuality::kGood;
+    partial += s.quality == trees::StemQuality::kPartial;
+  }
+  fmt::print("input      {} ({} points)\n", map_path.string(), cloud.size());
+  fmt::print("terrain    {} x {} cells of {} m, {} with ground points\n", inventory.terrain.nx(),
+             inventory.terrain.ny(), inventory.terrain.cellSize(),
+             inventory.terrain.measuredCells());
+  fmt::print("stems      {} ({} good, {} seen from one side, {} poor){}\n", stems.size(), good,
+             partial, stems.size() - good - partial,
+             grid ? fmt::format("; in EPSG:{}", grid->epsg) : "");
+  if (stems.empty())
+    fmt::print("           none found: heights are measured from the lowest points of each {} m "
+               "cell, so a cloud without ground (a slice, a tree cut above its base) has no "
+               "breast height\n",
+               inventory.terrain.cellSize());
+  fmt::print("outputs    {}/ (trees.csv, trees.geojson, dtm.asc{}) in {:.1f} s\n", out.string(),
+             options.no_map ? "" : ", trees_map.las", seconds);
+  return kExitOk;
+}
+}  // namespace
+
+Command addTreesCommand(CLI::App& tool) {
+  auto options = std::make_shared<TreesOptions>();
+  CLI::App* parser = tool.add_subcommand(
+      "trees", "Forest inventory of a map: ground, DTM, stems, DBH, tree list (docs/trees.md)");
+  parser
+      ->add_option("INPUT", options->input,
+                   "A run directory (its map.las, and georef/ when there is one) or a "
+                   "LAS/PLY/PCD cloud (e.g. a TLS plot)")
+      ->required()
+      ->check(CLI::ExistingPath);
+  parser->add_option("--out", options->out,
+                     "Output directory (default: the run directory, or the cloud's directory)");
+  parser->add_option("--dtm-cell", options->dtm_cell_m, "DTM cell size, m")
+      ->check(CLI::Range(0.1, 5.0));
+  parser->add_option("--min-dbh", options->min_dbh_m, "Thinner stems are not reported, m")
+      ->check(CLI::Range(0.02, 1.0));
+  parser->add_option("--breast-height", options->breast_height_m,
+                     "Height above the ground where the DBH is measured, m")
+      ->check(CLI::Range(0.5, 3.0));
+  parser->add_option("--epsg", options->epsg,
+                     "The cloud's coordinates are in this projected CRS (trees.csv and "
+                     "trees.geojson carry it)")
+      ->check(CLI::PositiveNumber);
+  parser->add_flag("--no-map", options->no_map, "Do not write the classified trees_map.las");
+  return {parser, [options] { return runTrees(*options); }, options};
+}
+
+}  // namespace taiga::app

@@ -1,0 +1,49 @@
+#pragma once
+// A robust circle fit to the horizontal cross-section of a stem (docs/trees.md, "Circle fit").
+//
+// Stem slices are not clean circles: branches, twigs and mixed edge returns lie off the stem, and a
+// stem seen from one side gives a partial arc. So the fit is (1) RANSAC over three-point circles,
+// scored by the points within a band of the circle, then (2) a geometric least-squares refinement
+// of (cx, cy, r) minimising sum w_i (|p_i - c| - r)^2 with Tukey's biweight w_i (iteratively
+// reweighted, the scale from the median absolute deviation of the residuals). A plain algebraic
+// (Kasa) fit would be pulled by every off-stem point and is biased small on partial arcs.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <span>
+
+namespace taiga::trees {
+
+struct CircleFitOptions {
+  double min_radius_m = 0.02;
+  double max_radius_m = 0.8;
+  /// A point is a RANSAC inlier within this distance of the circle, m (the map's noise plus the
+  /// bark's roughness).
+  double inlier_band_m = 0.025;
+  int ransac_iterations = 200;
+  std::uint64_t seed = 1;  ///< the RANSAC draws are deterministic for a given seed
+};
+
+struct CircleFit {
+  Eigen::Vector2d center_m = Eigen::Vector2d::Zero();
+  double radius_m = 0.0;
+  double rms_m = 0.0;          ///< RMS of the inliers' residuals |p - c| - r
+  std::size_t inliers = 0;     ///< points with a non-zero final weight
+  double arc_deg = 0.0;        ///< angular coverage of the inliers, in 10 deg sectors
+  double sigma_radius_m = 0.0; ///< 1-sigma of the radius from the weighted normal equations
+  double sigma_center_m = 0.0; ///< 1-sigma of the centre (the larger axis of its ellipse)
+};
+
+/// The fit to `points_m` (x, y), or nothing when no circle within the radius range has at least
+/// 5 inliers.
+std::optional<CircleFit> fitCircleRobust(std::span<const Eigen::Vector2d> points_m,
+                                         const CircleFitOptions& options = {});
+
+/// The geometric refinement alone, from a starting circle (used when the centre is known roughly,
+/// e.g. predicted from the slice below).
+std::optional<CircleFit> refineCircle(std::span<const Eigen::Vector2d> points_m,
+                                      const Eigen::Vector2d& center_m, double radius_m,
+                                      const CircleFitOptions& options = {});
+
+}  // namespace taiga::trees

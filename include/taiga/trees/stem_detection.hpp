@@ -1,0 +1,84 @@
+#pragma once
+// Stems, their diameter at breast height (DBH), position, lean and height, from a point cloud and
+// its terrain (docs/trees.md, "Stems").
+//
+// 1. Seeds: the points 1.0-1.6 m above the ground, rasterised at 5 cm and grouped into connected
+//    clusters; each cluster gets a robust circle fit (circle_fit.hpp).
+// 2. Along the stem: 0.3 m slices from 0.4 m up to 4 m (or the crown), each fitted with the
+//    circle of the slice next to it as the start, kept when its centre and radius agree with it.
+//    A stem needs at least three consistent slices: bushes, boulders, logs and branches do not
+//    give a vertical chain of circles.
+// 3. The axis: a line through the slice centres (least squares in x(h), y(h)): the lean and the
+//    position at breast height.
+// 4. DBH: one robust circle fit to the points 1.0-1.6 m above the ground with the axis' lean
+//    removed (each point moved by the axis' offset between its height and 1.3 m), so a thick band
+//    gives many points while the taper above and the butt swell below average out. A horizontal
+//    cut of a stem leaning by a is an ellipse with semi-axes r and r / cos(a): the fitted radius is
+//    scaled by 2 / (1 + 1 / cos a) back to the stem's own.
+// 5. Height: the highest point within 0.75 m of the axis carried up with its lean.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "taiga/trees/terrain_model.hpp"
+
+namespace taiga::trees {
+
+struct StemOptions {
+  double breast_height_m = 1.3;
+  double dbh_band_half_m = 0.3;  ///< DBH from the points breast_height +- this
+  double min_dbh_m = 0.07;       ///< thinner stems are not reported (saplings, shrubs)
+  double max_dbh_m = 1.2;
+  double slice_m = 0.3;
+  double lowest_slice_m = 0.4;   ///< the butt below is often hidden by vegetation and swells
+  double highest_slice_m = 4.0;  ///< slices are tracked up to here or to the crown
+  std::size_t min_slices = 3;    ///< consistent slices a stem needs (with the DBH band's own)
+  double max_lean_deg = 25.0;
+  double inlier_band_m = 0.025;  ///< see CircleFitOptions
+  double min_arc_deg = 60.0;     ///< a DBH fit on less of the circle is not reported
+};
+
+enum class StemQuality : std::uint8_t {
+  kGood,     ///< arc >= 180 deg, consistent axis, fit RMS <= 2 cm
+  kPartial,  ///< seen from one side (arc < 180 deg): the DBH is less certain
+  kPoor,     ///< large fit RMS or few slices: check it
+};
+std::string qualityName(StemQuality quality);
+
+struct Stem {
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  ///< axis at breast height (x, y, z)
+  double ground_z_m = 0.0;                               ///< terrain height under the stem
+  double dbh_m = 0.0;
+  double dbh_sigma_m = 0.0;  ///< 1-sigma of the DBH from the fit
+  double height_m = 0.0;     ///< highest point near the axis above the ground
+  double lean_deg = 0.0;
+  double lean_azimuth_deg = 0.0;  ///< direction of the lean, from +x towards +y
+  Eigen::Vector2d axis_slope = Eigen::Vector2d::Zero();  ///< d(x, y)/dh of the axis
+  std::size_t points = 0;  ///< inliers of the DBH fit
+  double fit_rms_m = 0.0;
+  double arc_deg = 0.0;
+  std::size_t slices = 0;      ///< consistent slices along the stem
+  double top_slice_m = 0.0;    ///< height of the highest consistent slice above the ground
+  StemQuality quality = StemQuality::kGood;
+
+  /// The axis at height h above the ground (x, y).
+  Eigen::Vector2d axisAt(double h_m, double breast_height_m = 1.3) const {
+    return position_m.head<2>() + axis_slope * (h_m - breast_height_m);
+  }
+};
+
+/// Stems in `points_m` (local coordinates, m) over `terrain`, sorted by x then y. Deterministic.
+std::vector<Stem> detectStems(std::span<const Eigen::Vector3d> points_m,
+                              const TerrainModel& terrain, const StemOptions& options = {});
+
+/// Per point: 0 when it is on no stem, else 1 + the index of the stem whose surface it lies on
+/// (within 5 cm of the fitted cylinder, from the ground up to the highest consistent slice).
+std::vector<std::uint32_t> stemMembership(std::span<const Eigen::Vector3d> points_m,
+                                          const TerrainModel& terrain,
+                                          std::span<const Stem> stems);
+
+}  // namespace taiga::trees

@@ -1,0 +1,154 @@
+#include "taiga/trees/circle_fit.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+namespace taiga::trees {
+namespace {
+
+using Eigen::Vector2d;
+
+struct Circle {
+  Vector2d center_m;
+  double radius_m = 0.0;
+};
+
+// The circle through three points (the circumcircle), or nothing when they are collinear.
+std::optional<Circle> circleThrough(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
+  const Vector2d ab = b - a, ac = c - a;
+  const double d = 2.0 * (ab.x() * ac.y() - ab.y() * ac.x());
+  if (std::abs(d) < 1e-12) return std::nullopt;
+  const double ab2 = ab.squaredNorm(), ac2 = ac.squaredNorm();
+  const Vector2d offset((ac.y() * ab2 - ab.y() * ac2) / d, (ab.x() * ac2 - ac.x() * ab2) / d);
+  return Circle{a + offset, offset.norm()};
+}
+
+std::size_t countWithin(std::span<const Vector2d> points_m, const Circle& circle, double band_m) {
+  std::size_t n = 0;
+  for (const Vector2d& p : points_m)
+    if (std::abs((p - circle.center_m).norm() - circle.radius_m) < band_m) ++n;
+  return n;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+// Tukey's biweight scale: 1.4826 MAD of the residuals near the circle, kept between a floor (a
+// perfect arc must not give weight only to a handful of points) and the RANSAC band.
+double robustScale(std::span<const Vector2d> points_m, const Circle& circle, double band_m) {
+  std::vector<double> near;
+  for (const Vector2d& p : points_m) {
+    const double e = std::abs((p - circle.center_m).norm() - circle.radius_m);
+    if (e < 3.0 * band_m) near.push_back(e);
+  }
+  return std::clamp(1.4826 * median(std::move(near)), 0.003, band_m);
+}
+
+double arcCoverageDeg(std::span<const Vector2d> points_m, const std::vector<double>& weights,
+                      const Vector2d& center_m) {
+  std::array<bool, 36> sector{};
+  for (std::size_t i = 0; i < points_m.size(); ++i) {
+    if (weights[i] <= 0.0) continue;
+    const Vector2d d = points_m[i] - center_m;
+    const double a = std::atan2(d.y(), d.x()) + std::numbers::pi;  // 0 .. 2 pi
+    sector[std::min<std::size_t>(35, static_cast<std::size_t>(a / (2.0 * std::numbers::pi) * 36))] =
+        true;
+  }
+  return 10.0 * static_cast<double>(std::count(sector.begin(), sector.end(), true));
+}
+
+}  // namespace
+
+std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m,
+                                      const Vector2d& center_m, double radius_m,
+                                      const CircleFitOptions& options) {
+  if (points_m.size() < 5) return std::nullopt;
+  Circle circle{center_m, radius_m};
+  const double scale_m = robustScale(points_m, circle, options.inlier_band_m);
+  const double tukey_m = 4.685 * scale_m;
+  std::vector<double> weights(points_m.size(), 0.0);
+  Eigen::Matrix3d JtWJ;
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    // Gauss-Newton on e_i = |p_i - c| - r: de/dc = -(p_i - c) / |p_i - c|, de/dr = -1.
+    JtWJ.setZero();
+    Eigen::Vector3d JtWe = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < points_m.size(); ++i) {
+      const Vector2d d = points_m[i] - circle.center_m;
+      const double distance = d.norm();
+      const double e = distance - circle.radius_m;
+      const double u = e / tukey_m;
+      weights[i] = (std::abs(u) < 1.0 && distance > 1e-9) ? (1 - u * u) * (1 - u * u) : 0.0;
+      if (weights[i] == 0.0) continue;
+      const Eigen::Vector3d J(-d.x() / distance, -d.y() / distance, -1.0);
+      JtWJ += weights[i] * J * J.transpose();
+      JtWe += weights[i] * J * e;
+    }
+    if (std::count_if(weights.begin(), weights.end(), [](double w) { return w > 0; }) < 5)
+      return std::nullopt;
+    const Eigen::Vector3d step = JtWJ.ldlt().solve(-JtWe);
+    if (!step.allFinite()) return std::nullopt;
+    circle.center_m += step.head<2>();
+    circle.radius_m += step.z();
+    if (step.norm() < 1e-7) break;
+  }
+  if (!(circle.radius_m >= options.min_radius_m && circle.radius_m <= options.max_radius_m))
+    return std::nullopt;
+
+  CircleFit fit;
+  fit.center_m = circle.center_m;
+  fit.radius_m = circle.radius_m;
+  double weighted_sq = 0.0, weight_sum = 0.0, inlier_sq = 0.0;
+  for (std::size_t i = 0; i < points_m.size(); ++i) {
+    if (weights[i] <= 0.0) continue;
+    const double e = (points_m[i] - circle.center_m).norm() - circle.radius_m;
+    weighted_sq += weights[i] * e * e;
+    weight_sum += weights[i];
+    inlier_sq += e * e;
+    ++fit.inliers;
+  }
+  fit.rms_m = std::sqrt(inlier_sq / static_cast<double>(fit.inliers));
+  // Covariance of (cx, cy, r): sigma^2 (J^T W J)^-1 with sigma^2 the weighted residual variance.
+  const double dof = std::max(1.0, weight_sum - 3.0);
+  const Eigen::Matrix3d covariance = (weighted_sq / dof) * JtWJ.inverse();
+  fit.sigma_radius_m = std::sqrt(std::max(0.0, covariance(2, 2)));
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> center(covariance.topLeftCorner<2, 2>());
+  fit.sigma_center_m = std::sqrt(std::max(0.0, center.eigenvalues().maxCoeff()));
+  fit.arc_deg = arcCoverageDeg(points_m, weights, circle.center_m);
+  return fit;
+}
+
+std::optional<CircleFit> fitCircleRobust(std::span<const Vector2d> points_m,
+                                         const CircleFitOptions& options) {
+  const std::size_t n = points_m.size();
+  if (n < 5) return std::nullopt;
+  std::mt19937_64 rng(options.seed);
+  std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+  std::optional<Circle> best;
+  std::size_t best_count = 0;
+  for (int iteration = 0; iteration < options.ransac_iterations; ++iteration) {
+    const std::size_t i = pick(rng), j = pick(rng), k = pick(rng);
+    if (i == j || j == k || i == k) continue;
+    const std::optional<Circle> circle = circleThrough(points_m[i], points_m[j], points_m[k]);
+    if (!circle || circle->radius_m < options.min_radius_m ||
+        circle->radius_m > options.max_radius_m)
+      continue;
+    const std::size_t count = countWithin(points_m, *circle, options.inlier_band_m);
+    if (count > best_count) {
+      best_count = count;
+      best = circle;
+    }
+  }
+  if (!best || best_count < 5) return std::nullopt;
+  return refineCircle(points_m, best->center_m, best->radius_m, options);
+}
+
+}  // namespace taiga::trees
