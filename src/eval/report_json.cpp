@@ -102,7 +102,20 @@ std::string formatEvalJson(const EvalReport& report) {
                   {"height_bias_m", t.height_bias_m},
                   {"overlap_ratio", t.overlap_ratio},
                   {"by_dbh", classes(t.by_dbh)},
-                  {"by_distance", classes(t.by_distance)}};
+                  {"by_distance", classes(t.by_distance)},
+                  {"missed_ref_ids", t.missed_ids},
+                  {"false_est_ids", t.false_ids}};
+    json matches = json::array();
+    for (const TreeMatch& m : t.matches)
+      matches.push_back({{"est_id", m.est_id},
+                         {"ref_id", m.ref_id},
+                         {"est_dbh_m", m.est_dbh_m},
+                         {"ref_dbh_m", m.ref_dbh_m},
+                         {"est_xy_m", {m.est_xy_m.x(), m.est_xy_m.y()}},
+                         {"ref_xy_m", {m.ref_xy_m.x(), m.ref_xy_m.y()}},
+                         {"position_error_m", (m.est_xy_m - m.ref_xy_m).norm()},
+                         {"path_distance_m", m.path_distance_m}});
+    j["trees"]["matches"] = std::move(matches);
   }
   return detail::dump(j);
 }

@@ -79,6 +79,7 @@ TreeAccuracy evaluateTrees(const std::vector<trees::TreeRecord>& estimate,
     ++by_distance.reference;
     if (!found) {
       a.missed_xy_m.push_back(ref.bh_xy_m);
+      a.missed_ids.push_back(ref.id);
       continue;
     }
     ++a.detected;
@@ -106,6 +107,7 @@ TreeAccuracy evaluateTrees(const std::vector<trees::TreeRecord>& estimate,
     if (est_match[i] < 0) {
       ++a.false_stems;
       a.false_xy_m.push_back(est_xy[i]);
+      a.false_ids.push_back(estimate[i].id);
     }
   }
   const auto n = static_cast<double>(a.detected);

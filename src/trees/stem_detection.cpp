@@ -210,6 +210,17 @@ double treeHeight(const CellMap<double>& canopy, double pixel_m,
   return top_m;
 }
 
+// A stem is solid: its cross-section has no points inside (a bush, a crown or a tangle of
+// branches that happens to fit a ring does). Allowed inside: noise, and a few stray returns.
+bool hollow(const std::vector<Vector2d>& points_m, const CircleFit& fit) {
+  const double core_m = fit.radius_m - std::max(0.03, 3.0 * fit.rms_m);
+  if (core_m <= 0.0) return true;
+  const auto inside = std::count_if(points_m.begin(), points_m.end(), [&](const Vector2d& p) {
+    return (p - fit.center_m).norm() < core_m;
+  });
+  return static_cast<double>(inside) <= 0.05 * static_cast<double>(fit.inliers) + 2.0;
+}
+
 }  // namespace
 
 std::string qualityName(StemQuality quality) {
@@ -271,7 +282,9 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
                         });
       const std::optional<CircleFit> dbh_fit =
           refineCircle(upright, axis.at_breast_height, seed->radius_m, fit);
-      if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg) continue;
+      if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > o.max_fit_rms_m ||
+          !hollow(upright, *dbh_fit))
+        continue;
       const double lean_scale = 2.0 / (1.0 + 1.0 / std::cos(lean_rad));
       Stem stem;
       stem.dbh_m = 2.0 * dbh_fit->radius_m * lean_scale;

@@ -53,6 +53,7 @@ struct TreeAccuracy {
   std::vector<TreeClass> by_dbh, by_distance;
   std::vector<TreeMatch> matches;
   std::vector<Eigen::Vector2d> missed_xy_m, false_xy_m;  ///< for the tree map plot
+  std::vector<long> missed_ids, false_ids;
 };
 
 /// `estimate` is moved into the reference frame with `T` (est -> ref); `reference_path_m` is the

@@ -6,8 +6,9 @@
 //    clusters; each cluster gets a robust circle fit (circle_fit.hpp).
 // 2. Along the stem: 0.3 m slices from 0.4 m up to 4 m (or the crown), each fitted with the
 //    circle of the slice next to it as the start, kept when its centre and radius agree with it.
-//    A stem needs at least three consistent slices: bushes, boulders, logs and branches do not
-//    give a vertical chain of circles.
+//    A stem needs at least five consistent slices: bushes, boulders, logs and branches do not
+//    give a vertical chain of circles. A stem is also solid: a ring with points inside it (a
+//    crown, a bush) is not one.
 // 3. The axis: a line through the slice centres (least squares in x(h), y(h)): the lean and the
 //    position at breast height.
 // 4. DBH: one robust circle fit to the points 1.0-1.6 m above the ground with the axis' lean
@@ -36,10 +37,11 @@ struct StemOptions {
   double slice_m = 0.3;
   double lowest_slice_m = 0.4;   ///< the butt below is often hidden by vegetation and swells
   double highest_slice_m = 4.0;  ///< slices are tracked up to here or to the crown
-  std::size_t min_slices = 3;    ///< consistent slices a stem needs (with the DBH band's own)
+  std::size_t min_slices = 5;    ///< consistent slices a stem needs, the DBH band included (1.5 m of stem)
   double max_lean_deg = 25.0;
   double inlier_band_m = 0.025;  ///< see CircleFitOptions
   double min_arc_deg = 60.0;     ///< a DBH fit on less of the circle is not reported
+  double max_fit_rms_m = 0.03;   ///< nor one whose inliers scatter more (foliage, clutter)
 };
 
 enum class StemQuality : std::uint8_t {
