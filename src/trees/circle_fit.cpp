@@ -28,11 +28,19 @@ std::optional<Circle> circleThrough(const Vector2d& a, const Vector2d& b, const 
   return Circle{a + offset, offset.norm()};
 }
 
-std::size_t countWithin(std::span<const Vector2d> points_m, const Circle& circle, double band_m) {
-  std::size_t n = 0;
-  for (const Vector2d& p : points_m)
-    if (std::abs((p - circle.center_m).norm() - circle.radius_m) < band_m) ++n;
-  return n;
+// RANSAC score: points on the ring, minus those well inside it. A stem is solid, so a large
+// circle through branches and foliage around it (many points, many inside) loses to the stem's
+// own ring.
+long ringScore(std::span<const Vector2d> points_m, const Circle& circle, double band_m) {
+  long score = 0;
+  for (const Vector2d& p : points_m) {
+    const double e = (p - circle.center_m).norm() - circle.radius_m;
+    if (std::abs(e) < band_m)
+      ++score;
+    else if (e < -2.0 * band_m)
+      --score;
+  }
+  return score;
 }
 
 double median(std::vector<double> values) {
@@ -132,8 +140,16 @@ std::optional<CircleFit> fitCircleRobust(std::span<const Vector2d> points_m,
   if (n < 5) return std::nullopt;
   std::mt19937_64 rng(options.seed);
   std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+  // Scored on at most 400 points: enough to rank circles, and the cost stays flat for big
+  // clusters (a crowded cluster needs many draws: with 20 % of its points on the stem, 1000 draws
+  // find three of them with 99.97 % probability).
+  std::vector<Vector2d> sample(points_m.begin(), points_m.end());
+  if (sample.size() > 400) {
+    std::shuffle(sample.begin(), sample.end(), rng);
+    sample.resize(400);
+  }
   std::optional<Circle> best;
-  std::size_t best_count = 0;
+  long best_score = 0;
   for (int iteration = 0; iteration < options.ransac_iterations; ++iteration) {
     const std::size_t i = pick(rng), j = pick(rng), k = pick(rng);
     if (i == j || j == k || i == k) continue;
@@ -141,13 +157,13 @@ std::optional<CircleFit> fitCircleRobust(std::span<const Vector2d> points_m,
     if (!circle || circle->radius_m < options.min_radius_m ||
         circle->radius_m > options.max_radius_m)
       continue;
-    const std::size_t count = countWithin(points_m, *circle, options.inlier_band_m);
-    if (count > best_count) {
-      best_count = count;
+    const long score = ringScore(sample, *circle, options.inlier_band_m);
+    if (score > best_score) {
+      best_score = score;
       best = circle;
     }
   }
-  if (!best || best_count < 5) return std::nullopt;
+  if (!best || best_score < 5) return std::nullopt;
   return refineCircle(points_m, best->center_m, best->radius_m, options);
 }
 

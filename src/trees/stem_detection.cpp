@@ -211,14 +211,15 @@ double treeHeight(const CellMap<double>& canopy, double pixel_m,
 }
 
 // A stem is solid: its cross-section has no points inside (a bush, a crown or a tangle of
-// branches that happens to fit a ring does). Allowed inside: noise, and a few stray returns.
+// branches that happens to fit a ring does). Allowed inside: noise, and stray returns (a real
+// TLS spruce has 5-8 % of its ring count there: branch stubs, scans slightly misaligned).
 bool hollow(const std::vector<Vector2d>& points_m, const CircleFit& fit) {
   const double core_m = fit.radius_m - std::max(0.03, 3.0 * fit.rms_m);
   if (core_m <= 0.0) return true;
   const auto inside = std::count_if(points_m.begin(), points_m.end(), [&](const Vector2d& p) {
     return (p - fit.center_m).norm() < core_m;
   });
-  return static_cast<double>(inside) <= 0.05 * static_cast<double>(fit.inliers) + 2.0;
+  return static_cast<double>(inside) <= 0.15 * static_cast<double>(fit.inliers) + 2.0;
 }
 
 }  // namespace

@@ -21,7 +21,7 @@ struct CircleFitOptions {
   /// A point is a RANSAC inlier within this distance of the circle, m (the map's noise plus the
   /// bark's roughness).
   double inlier_band_m = 0.025;
-  int ransac_iterations = 200;
+  int ransac_iterations = 1000;
   std::uint64_t seed = 1;  ///< the RANSAC draws are deterministic for a given seed
 };
 

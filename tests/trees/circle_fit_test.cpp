@@ -1,0 +1,77 @@
+#include "taiga/trees/circle_fit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "taiga/io/cloud_files.hpp"
+
+namespace taiga::trees {
+namespace {
+
+using Eigen::Vector2d;
+
+std::vector<Vector2d> arc(Vector2d c, double r, double from_rad, double to_rad, int n,
+                          double noise_m, std::mt19937& rng) {
+  std::normal_distribution<double> noise(0.0, noise_m);
+  std::vector<Vector2d> points;
+  for (int i = 0; i < n; ++i) {
+    const double a = from_rad + (to_rad - from_rad) * i / (n - 1);
+    points.push_back(c + (r + noise(rng)) * Vector2d(std::cos(a), std::sin(a)));
+  }
+  return points;
+}
+
+TEST(CircleFit, APartialArcWithBranchesAndFoliageGivesTheStem) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    std::mt19937 rng(seed);
+    // 120 deg of a 30 cm stem seen from one side, 5 mm noise, and 40 % of the points elsewhere:
+    // a branch leaving the stem and a ball of foliage next to it.
+    std::vector<Vector2d> points = arc({2.0, 1.0}, 0.15, -1.0, 1.1, 300, 0.005, rng);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int i = 0; i < 100; ++i) points.push_back(Vector2d(2.15 + 0.8 * u(rng), 1.0 + 0.02 * u(rng)));
+    for (int i = 0; i < 100; ++i) points.push_back(Vector2d(2.6, 0.5) + 0.4 * Vector2d(u(rng), u(rng)));
+    const auto fit = fitCircleRobust(points, {.seed = seed});
+    ASSERT_TRUE(fit) << seed;
+    EXPECT_NEAR(fit->radius_m, 0.15, 0.004) << seed;
+    EXPECT_LT((fit->center_m - Vector2d(2.0, 1.0)).norm(), 0.006) << seed;
+    EXPECT_NEAR(fit->arc_deg, 120.0, 20.0);
+    EXPECT_LT(fit->rms_m, 0.008);
+    EXPECT_GT(fit->sigma_radius_m, 0.0);
+  }
+}
+
+TEST(CircleFit, RefusesWhatHasNoCircleInTheRadiusRange) {
+  std::mt19937 rng(4);
+  // A straight line (a log's edge, a wall) and a circle larger than allowed.
+  std::vector<Vector2d> line;
+  for (int i = 0; i < 100; ++i) line.push_back(Vector2d(0.01 * i, 0.0));
+  EXPECT_FALSE(fitCircleRobust(line, {.max_radius_m = 0.6}));
+  EXPECT_FALSE(fitCircleRobust(arc({0, 0}, 2.0, 0, 6.28, 200, 0.002, rng), {.max_radius_m = 0.6}));
+  EXPECT_FALSE(fitCircleRobust(std::vector<Vector2d>(3, Vector2d::Zero())));
+}
+
+// The real stem slice of lidR (a 10 cm slice at 4.1 m with off-stem returns: a plain least-squares
+// circle on all points gives r 0.34 m, RMS 0.10 m). The reference, fitted by hand
+// (docs/trees.md, "Real clouds"): an exhaustive grid over centres (2 cm) and radii (1 cm) scored by
+// points within 1.5 cm of the ring less points more than 5 cm inside it, then least squares on
+// the points of an annulus shrunk to 3x the RMS in six rounds: centre (101.4508, 152.0206),
+// r 0.1440 m, RMS 3.2 mm, 972 of 1369 points.
+TEST(CircleFit, TheRealLidrSliceAgreesWithTheManualFit) {
+  const io::DecodedPoints slice =
+      io::readPointCloudFile("../shared/data/forest/lidr_dbh_slice.ply", 0.0);
+  std::vector<Vector2d> points;
+  for (const Eigen::Vector3d& p : slice.cloud.positions) points.push_back(p.head<2>());
+  ASSERT_EQ(points.size(), 1369u);
+  const auto fit = fitCircleRobust(points);
+  ASSERT_TRUE(fit);
+  EXPECT_NEAR(fit->radius_m, 0.1440, 0.003);
+  EXPECT_LT((fit->center_m - Vector2d(101.4508, 152.0206)).norm(), 0.004);
+  EXPECT_LT(fit->rms_m, 0.006);
+  EXPECT_GT(fit->inliers, 800u);
+}
+
+}  // namespace
+}  // namespace taiga::trees

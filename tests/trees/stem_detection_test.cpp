@@ -1,0 +1,89 @@
+#include "taiga/trees/stem_detection.hpp"
+
+#include <gtest/gtest.h>
+
+#include <numbers>
+
+#include "forest_fixture.hpp"
+#include "taiga/core/errors.hpp"
+#include "taiga/trees/inventory.hpp"
+
+namespace taiga::trees {
+namespace {
+
+using test::SyntheticStem;
+
+const std::vector<SyntheticStem> kStems{
+    {{0.0, 0.0}, 0.30},
+    {{3.0, 2.0}, 0.12, 0.05},  // leaning 2.9 deg towards +x
+    {{-4.0, -2.0}, 0.45},
+    // Seen from one side (the strip road): 140 deg of the ring.
+    {{4.0, -4.0}, 0.22, 0.0, -0.5 * std::numbers::pi, 0.28 * std::numbers::pi},
+};
+
+TEST(Terrain, SlopedGroundUnderStemsABoulderALogAndABush) {
+  const auto points = test::syntheticForest(kStems, 0.005);
+  const TerrainModel terrain = buildTerrainModel(points);
+  for (double x = -9; x <= 9; x += 1.5)
+    for (double y = -9; y <= 9; y += 1.5)
+      EXPECT_NEAR(terrain.heightAt(x, y), test::groundZ(x, y), 0.05) << x << " " << y;
+  // The boulder's top (1 m) and the log are not ground.
+  EXPECT_NEAR(terrain.heightAt(6, -6), test::groundZ(6, -6), 0.1);
+  EXPECT_NEAR(terrain.heightAt(-6, -5), test::groundZ(-6, -5), 0.1);
+}
+
+TEST(Terrain, NoFinitePointsIsAnError) {
+  const std::vector<Eigen::Vector3d> none{Eigen::Vector3d::Constant(std::nan(""))};
+  EXPECT_THROW(buildTerrainModel(none), InputError);
+  EXPECT_THROW(buildTerrainModel(std::vector<Eigen::Vector3d>{}), InputError);
+}
+
+TEST(Stems, EveryStemWithItsDbhLeanAndPositionAndNothingElse) {
+  for (unsigned seed : {1u, 2u}) {
+    const auto points = test::syntheticForest(kStems, 0.005, seed);
+    const Inventory inventory = takeInventory(points);
+    ASSERT_EQ(inventory.stems.size(), kStems.size()) << seed;  // no boulder, log or bush
+    for (const SyntheticStem& truth : kStems) {
+      const Eigen::Vector2d bh = truth.base_xy + Eigen::Vector2d(truth.lean_x * 1.3, 0.0);
+      const Stem* found = nullptr;
+      for (const Stem& s : inventory.stems)
+        if ((s.position_m.head<2>() - bh).norm() < 0.1) found = &s;
+      ASSERT_NE(found, nullptr) << bh.transpose();
+      EXPECT_NEAR(found->dbh_m, truth.dbh_m, 0.004) << bh.transpose();
+      EXPECT_LT((found->position_m.head<2>() - bh).norm(), 0.005);
+      EXPECT_NEAR(found->lean_deg, std::atan(truth.lean_x) * 180 / std::numbers::pi, 0.5);
+      EXPECT_NEAR(found->ground_z_m, test::groundZ(bh.x(), bh.y()), 0.03);
+      EXPECT_GE(found->height_m, 5.8);
+      EXPECT_EQ(found->quality, truth.max_angle_rad - truth.min_angle_rad < std::numbers::pi
+                                    ? StemQuality::kPartial
+                                    : StemQuality::kGood);
+    }
+  }
+}
+
+TEST(Stems, PointsAreLabelledGroundStemOrOther) {
+  const auto points = test::syntheticForest(kStems, 0.005);
+  const Inventory inventory = takeInventory(points);
+  const PointLabels labels = labelPoints(points, inventory);
+  std::size_t ground = 0, stem = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    ground += labels.classification[i] == kClassGround;
+    stem += labels.classification[i] == kClassStem;
+    if (labels.classification[i] == kClassStem) {
+      EXPECT_GT(labels.tree_id[i], 0);
+    }
+  }
+  EXPECT_GT(ground, 38000u);  // the 201 x 201 ground grid, less what stems stand on
+  // Stem points are labelled up to the highest tracked slice (4 m): 4 x 200 rings x 60.
+  EXPECT_GT(stem, 40000u);
+  // The first point, on the ground far from anything, is ground.
+  EXPECT_EQ(labels.classification[0], kClassGround);
+}
+
+TEST(Stems, ACloudWithoutStemsGivesNone) {
+  const auto points = test::syntheticForest({}, 0.005);
+  EXPECT_TRUE(takeInventory(points).stems.empty());
+}
+
+}  // namespace
+}  // namespace taiga::trees
