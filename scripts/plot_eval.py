@@ -100,6 +100,50 @@ def plot_eval(data, out_dir, written):
 
     if "timing" in data:
         plot_timing(data["timing"], out_dir, written, "processing time per scan")
+    if "trees" in data:
+        plot_trees(data["trees"], ref, out_dir, written)
+
+
+def plot_trees(trees, reference, out_dir, written):
+    """The tree map (`taiga eval --trees`): matched stems coloured by their DBH error, missed
+    reference trees and false stems, over the reference path."""
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(15, 6.5), gridspec_kw={"width_ratios": [3, 2]})
+    rx, ry = xy(reference)
+    ax1.plot(rx, ry, color="black", linewidth=1, label="reference path")
+    matched = trees["matches"]
+    if matched:
+        errors_cm = [100 * (m["est_dbh_m"] - m["ref_dbh_m"]) for m in matched]
+        bound = max(2.0, max(abs(e) for e in errors_cm))
+        points = ax1.scatter([m["ref_xy_m"][0] for m in matched], [m["ref_xy_m"][1] for m in matched],
+                             s=[3000 * m["ref_dbh_m"] ** 2 + 8 for m in matched], c=errors_cm,
+                             cmap="coolwarm", vmin=-bound, vmax=bound, edgecolors="black",
+                             linewidths=0.3, label=f"found ({len(matched)})")
+        fig.colorbar(points, ax=ax1, label="DBH error (cm), est - ref")
+    for key, marker, colour, label in (("missed_xy_m", "x", "red", "missed reference tree"),
+                                       ("false_xy_m", "+", "purple", "false stem")):
+        if trees[key]:
+            ax1.scatter([p[0] for p in trees[key]], [p[1] for p in trees[key]], marker=marker,
+                        s=60, color=colour, label=f"{label} ({len(trees[key])})")
+    ax1.set_xlabel("x (m)")
+    ax1.set_ylabel("y (m)")
+    ax1.set_aspect("equal", adjustable="datalim")
+    ax1.grid(True, alpha=0.3)
+    ax1.legend(fontsize="small", loc="upper right")
+    ax1.set_title(f"trees within {trees['max_path_distance_m']:g} m of the path, DBH >= "
+                  f"{100 * trees['min_dbh_m']:g} cm: {100 * trees['recall']:.1f} % found, "
+                  f"{100 * trees['commission']:.1f} % false")
+    if matched:
+        ax2.scatter([100 * m["ref_dbh_m"] for m in matched], [100 * m["est_dbh_m"] for m in matched],
+                    s=12, c=[m["path_distance_m"] for m in matched], cmap="viridis")
+        lo = min(100 * m["ref_dbh_m"] for m in matched)
+        hi = max(100 * m["ref_dbh_m"] for m in matched)
+        ax2.plot([lo, hi], [lo, hi], color="black", linewidth=0.8)
+    ax2.set_xlabel("reference DBH (cm)")
+    ax2.set_ylabel("estimated DBH (cm), colour: distance from the path")
+    ax2.set_title(f"DBH RMSE {100 * trees['dbh_rmse_m']:.2f} cm, bias {100 * trees['dbh_bias_m']:+.2f} cm")
+    ax2.set_aspect("equal", adjustable="datalim")
+    ax2.grid(True, alpha=0.3)
+    save(fig, out_dir, "trees.png", written)
 
 
 def plot_compare(data, out_dir, written):

@@ -132,6 +132,29 @@ std::string formatEvalPlotData(const EvalReport& report) {
   j["ape_m"] = r.ape.translation_error_m;
   if (report.timing_table && report.timing)
     j["timing"] = detail::timingSeriesJson(*report.timing_table, *report.timing);
+  if (report.trees) {
+    const TreeAccuracy& t = *report.trees;
+    auto points = [](const std::vector<Eigen::Vector2d>& list) {
+      json out = json::array();
+      for (const Eigen::Vector2d& p : list) out.push_back({p.x(), p.y()});
+      return out;
+    };
+    json matches = json::array();
+    for (const TreeMatch& m : t.matches)
+      matches.push_back({{"ref_xy_m", {m.ref_xy_m.x(), m.ref_xy_m.y()}},
+                         {"est_dbh_m", m.est_dbh_m},
+                         {"ref_dbh_m", m.ref_dbh_m},
+                         {"path_distance_m", m.path_distance_m}});
+    j["trees"] = {{"matches", std::move(matches)},
+                  {"missed_xy_m", points(t.missed_xy_m)},
+                  {"false_xy_m", points(t.false_xy_m)},
+                  {"recall", t.recall},
+                  {"commission", t.commission},
+                  {"dbh_rmse_m", t.dbh_rmse_m},
+                  {"dbh_bias_m", t.dbh_bias_m},
+                  {"min_dbh_m", t.options.min_dbh_m},
+                  {"max_path_distance_m", t.options.max_path_distance_m}};
+  }
   return detail::dump(j);
 }
 
