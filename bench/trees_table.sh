@@ -17,9 +17,9 @@ for c in $cases; do
   realism=${REALISM:-ideal}
   rec="$out/${scenario}_${seed}_${realism}"
   [ -f "$rec/recording.bag" ] || "$taiga" simulate --scenario "$scenario" --realism "$realism" \
-    --duration "$duration" --seed "$seed" --beams "$beams" --out "$rec" >/dev/null
+    --duration "$duration" --seed "$seed" --beams "$beams" --out "$rec" >/dev/null 2>&1
   [ -f "$rec/run/map.las" ] || "$taiga" run "$rec/recording.bag" --config "$rec/rig.yaml" \
-    --out "$rec/run" >/dev/null
+    --out "$rec/run" >"$rec/run.log" 2>&1
   start_ns=$(date +%s%N)
   "$taiga" trees "$rec/run" --out "$rec/trees" >/dev/null
   milliseconds=$((($(date +%s%N) - start_ns) / 1000000))
