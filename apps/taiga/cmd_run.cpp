@@ -114,6 +114,9 @@ int run(const RunOptions& options) {
       s.mean_ms, s.p95_ms, s.max_ms, s.realtime_factor, s.peak_memory_mb);
   fmt::print("mapping    {} loop closures (loops.csv); map exported in {:.1f} s after the run\n",
              s.loop_closures, s.map_export_s);
+  if (s.trees)
+    fmt::print("trees      {} stems in trees.csv (online; worker busy {:.1f} s)\n", *s.trees,
+               s.trees_work_s);
   if (s.realtime) {
     fmt::print(
         "realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "

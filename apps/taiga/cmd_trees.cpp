@@ -27,6 +27,7 @@ struct TreesOptions {
   double dtm_cell_m = 0.5;
   double min_dbh_m = 0.07;
   double breast_height_m = 1.3;
+  double max_fit_rms_m = 0.045;
   int epsg = 0;
   bool no_map = false;
 };
@@ -107,6 +108,7 @@ int runTrees(const TreesOptions& options) {
   io_options.terrain.cell_m = options.dtm_cell_m;
   io_options.stems.min_dbh_m = options.min_dbh_m;
   io_options.stems.breast_height_m = options.breast_height_m;
+  io_options.stems.max_fit_rms_m = options.max_fit_rms_m;
   const trees::Inventory inventory = trees::takeInventory(local, io_options);
   const std::vector<trees::Stem>& stems = inventory.stems;
 
@@ -164,6 +166,10 @@ Command addTreesCommand(CLI::App& tool) {
   parser->add_option("--breast-height", options->breast_height_m,
                      "Height above the ground where the DBH is measured, m")
       ->check(CLI::Range(0.5, 3.0));
+  parser->add_option("--max-fit-rms", options->max_fit_rms_m,
+                     "Stem cross-sections whose points scatter more are not stems, m (2/3 of it "
+                     "for stems tracked over less than 2.7 m)")
+      ->check(CLI::Range(0.005, 0.2));
   parser->add_option("--epsg", options->epsg,
                      "The cloud's coordinates are in this projected CRS (trees.csv and "
                      "trees.geojson carry it)")

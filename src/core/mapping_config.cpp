@@ -33,6 +33,8 @@ void MappingConfig::visit(ConfigVisitor& v) {
           "m, the search reaches this far on each side of the dead-reckoned position, in x and y");
   v.field("relocalization_search_deg", relocalization_search_deg,
           "deg, and this far on each side of the dead-reckoned heading");
+  v.field("trees", trees,
+          "detect stems while the run goes and keep RUN/trees.csv up to date (docs/trees.md)");
   v.field("odometry_sigma_m", odometry_sigma_m,
           "m, sigma of the translation between consecutive keyframes, at zero distance");
   v.field("odometry_sigma_m_per_m", odometry_sigma_m_per_m,

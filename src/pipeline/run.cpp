@@ -13,6 +13,7 @@
 #include "recording_feed.hpp"
 #include "run_georef.hpp"
 #include "run_health.hpp"
+#include "online_trees.hpp"
 #include "run_outputs.hpp"
 #include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
@@ -213,6 +214,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   slam.addObserver(scan_log);
   slam.addObserver(health);
   slam.addObserver(gnss);
+  std::optional<OnlineTrees> online_trees;
+  if (config.mapping.trees) slam.addObserver(online_trees.emplace(slam.keyframes(), out / "trees.csv"));
 
   RunSummary summary;
   const auto wall_start = Clock::now();
@@ -234,6 +237,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
         "0.5 s of IMU readings before the scans, or odometry.imu_use: lidar_only",
         recording_path.string(), summary.scans, summary.imu_samples));
 
+  if (online_trees) {
+    summary.trees = online_trees->finish(mapper.graph().poses());
+    summary.trees_work_s = online_trees->workSeconds();
+  }
   const Trajectory corrected = trajectories.write(out, mapper.graph());
   writeLoops(out / "loops.csv", mapper.loopAttempts());
   io::writeTum(out / "keyframes.tum", slam.keyframes().trajectory());

@@ -61,6 +61,23 @@ double robustScale(std::span<const Vector2d> points_m, const Circle& circle, dou
   return std::clamp(1.4826 * median(std::move(near)), 0.003, band_m);
 }
 
+// Share of the inliers in the densest 30 deg of the circle.
+double densestShare(std::span<const Vector2d> points_m, const std::vector<double>& weights,
+                    const Vector2d& center_m) {
+  std::array<int, 36> count{};
+  int total = 0;
+  for (std::size_t i = 0; i < points_m.size(); ++i) {
+    if (weights[i] <= 0.0) continue;
+    const Vector2d d = points_m[i] - center_m;
+    const double a = std::atan2(d.y(), d.x()) + std::numbers::pi;
+    ++count[std::min<std::size_t>(35, static_cast<std::size_t>(a / (2.0 * std::numbers::pi) * 36))];
+    ++total;
+  }
+  int best = 0;
+  for (int k = 0; k < 36; ++k) best = std::max(best, count[k] + count[(k + 1) % 36] + count[(k + 2) % 36]);
+  return total > 0 ? static_cast<double>(best) / total : 1.0;
+}
+
 double arcCoverageDeg(std::span<const Vector2d> points_m, const std::vector<double>& weights,
                       const Vector2d& center_m) {
   std::array<bool, 36> sector{};
@@ -131,6 +148,7 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m,
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> center(covariance.topLeftCorner<2, 2>());
   fit.sigma_center_m = std::sqrt(std::max(0.0, center.eigenvalues().maxCoeff()));
   fit.arc_deg = arcCoverageDeg(points_m, weights, circle.center_m);
+  fit.densest_share = densestShare(points_m, weights, circle.center_m);
   return fit;
 }
 

@@ -283,8 +283,10 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
                         });
       const std::optional<CircleFit> dbh_fit =
           refineCircle(upright, axis.at_breast_height, seed->radius_m, fit);
-      if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > o.max_fit_rms_m ||
-          !hollow(upright, *dbh_fit))
+      const double max_rms_m =
+          slices.size() >= o.long_stem_slices ? o.max_fit_rms_m : 2.0 / 3.0 * o.max_fit_rms_m;
+      if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > max_rms_m ||
+          dbh_fit->densest_share > o.max_densest_share || !hollow(upright, *dbh_fit))
         continue;
       const double lean_scale = 2.0 / (1.0 + 1.0 / std::cos(lean_rad));
       Stem stem;

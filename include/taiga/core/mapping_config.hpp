@@ -32,6 +32,8 @@ struct MappingConfig final : ConfigSection {
   bool relocalization = true;
   double relocalization_search_m = 4.0;     ///< m, on each side, in x and in y
   double relocalization_search_deg = 45.0;  ///< deg of heading, on each side
+  // The tree map while the run goes (pipeline/online_trees.hpp, docs/trees.md): RUN/trees.csv.
+  bool trees = false;
   // Odometry between consecutive keyframes: sigma = floor + per-metre growth * distance.
   double odometry_sigma_m = 0.002;
   double odometry_sigma_m_per_m = 0.003;

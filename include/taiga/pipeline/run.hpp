@@ -158,6 +158,9 @@ struct RunSummary {
   std::optional<RealtimeReport> realtime;           ///< with --realtime only
   std::optional<GeorefRunReport> georef;            ///< when the recording has GNSS fixes
   std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
+  /// With mapping.trees: the stems of the online tree map and its worker's busy time, s.
+  std::optional<std::size_t> trees;
+  double trees_work_s = 0.0;
 };
 
 /// Runs the odometry over `recording` and writes the outputs into options.out_dir (created).

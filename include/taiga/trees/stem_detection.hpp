@@ -41,7 +41,14 @@ struct StemOptions {
   double max_lean_deg = 25.0;
   double inlier_band_m = 0.025;  ///< see CircleFitOptions
   double min_arc_deg = 60.0;     ///< a DBH fit on less of the circle is not reported
-  double max_fit_rms_m = 0.03;   ///< nor one whose inliers scatter more (foliage, clutter)
+  /// Nor one whose inliers scatter more (foliage, clutter that happens to make a ring); a stem
+  /// tracked through fewer than long_stem_slices slices must scatter less than 2/3 of it: on noisy
+  /// maps true stems scatter up to 3-4 cm but are long, while false rings were at most 8 slices.
+  double max_fit_rms_m = 0.045;
+  std::size_t long_stem_slices = 9;
+  /// Nor a ring whose inliers crowd into 30 deg of it: a large ring through one stem's visible
+  /// arc and the clutter around it, whose radius means nothing.
+  double max_densest_share = 0.6;
 };
 
 enum class StemQuality : std::uint8_t {

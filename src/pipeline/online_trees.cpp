@@ -1,0 +1,172 @@
+#include "online_trees.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include "taiga/core/errors.hpp"
+#include "taiga/core/log.hpp"
+#include "taiga/trees/inventory.hpp"
+#include "taiga/trees/tree_files.hpp"
+
+namespace taiga::pipeline {
+namespace {
+
+constexpr std::size_t kKeyframesPerUpdate = 10;
+constexpr double kRegionKeyframes_m = 10.0;  ///< keyframes this close to a new one are loaded
+constexpr double kCropMargin_m = 20.0;       ///< points this far beyond the new keyframes are kept
+constexpr double kSeen_m = 15.0;             ///< stems this close to a new keyframe are refitted
+
+double distanceXy(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return (a.head<2>() - b.head<2>()).norm();
+}
+
+bool overlap(const trees::Stem& a, const trees::Stem& b) {
+  return distanceXy(a.position_m, b.position_m) < 0.5 * (a.dbh_m + b.dbh_m) + 0.1;
+}
+
+}  // namespace
+
+OnlineTrees::OnlineTrees(const mapping::KeyframeStore& store, std::filesystem::path trees_csv)
+    : store_(store), trees_csv_(std::move(trees_csv)), worker_([this] { run(); }) {}
+
+OnlineTrees::~OnlineTrees() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void OnlineTrees::onScan(const ScanOutcome& /*scan*/, const lie::SE3& T_map_odom) {
+  T_map_odom_ = T_map_odom;
+}
+
+void OnlineTrees::onKeyframe(std::uint64_t id, const ScanOutcome& scan) {
+  const Keyframe keyframe{id, T_map_odom_ * scan.T_odom_body};
+  std::lock_guard lock(mutex_);
+  keyframes_.push_back(keyframe);
+  pending_.push_back(keyframe);
+  if (pending_.size() >= kKeyframesPerUpdate) {
+    jobs_.push_back(std::move(pending_));
+    pending_.clear();
+    wake_.notify_all();
+  }
+}
+
+void OnlineTrees::run() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [this] { return stopping_ || !jobs_.empty(); });
+    if (jobs_.empty()) return;  // stopping, and every job done
+    std::vector<Keyframe> fresh = std::move(jobs_.front());
+    jobs_.pop_front();
+    lock.unlock();
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      update(fresh);
+    } catch (const std::exception& e) {  // a keyframe file unreadable: the tree map goes on
+      logger().warn("online tree map: update skipped: {}", e.what());
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    lock.lock();
+    work_s_ += seconds;
+  }
+}
+
+void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
+  std::vector<Keyframe> all;
+  {
+    std::lock_guard lock(mutex_);
+    all = keyframes_;
+  }
+  auto nearestFresh = [&](const Eigen::Vector3d& p) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Keyframe& k : fresh) best = std::min(best, distanceXy(p, k.T_map_body.translation()));
+    return best;
+  };
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  for (const Keyframe& k : fresh) center += k.T_map_body.translation();
+  center /= static_cast<double>(fresh.size());
+  double crop_m = 0.0;
+  for (const Keyframe& k : fresh) crop_m = std::max(crop_m, distanceXy(k.T_map_body.translation(), center));
+  crop_m += kCropMargin_m;
+
+  std::vector<Eigen::Vector3d> points_m;
+  for (const Keyframe& k : all) {
+    if (nearestFresh(k.T_map_body.translation()) > kRegionKeyframes_m) continue;
+    for (const Eigen::Vector3d& p_body : store_.load(k.id).positions) {
+      const Eigen::Vector3d p = k.T_map_body * p_body;
+      if (distanceXy(p, center) <= crop_m) points_m.push_back(p);
+    }
+  }
+  if (points_m.empty()) return;
+  const trees::Inventory inventory = trees::takeInventory(points_m);
+
+  for (const trees::Stem& stem : inventory.stems) {
+    const bool seen_here = nearestFresh(stem.position_m) <= kSeen_m;
+    const bool known = std::any_of(stems_.begin(), stems_.end(),
+                                   [&](const AnchoredStem& s) { return overlap(s.stem, stem); });
+    if (known && !seen_here) continue;
+    std::erase_if(stems_, [&](const AnchoredStem& s) { return overlap(s.stem, stem); });
+    // Anchored to the nearest new keyframe (in its body frame).
+    const Keyframe* anchor = &fresh.front();
+    for (const Keyframe& k : fresh)
+      if (distanceXy(k.T_map_body.translation(), stem.position_m) <
+          distanceXy(anchor->T_map_body.translation(), stem.position_m))
+        anchor = &k;
+    const Eigen::Vector3d axis_map =
+        Eigen::Vector3d(stem.axis_slope.x(), stem.axis_slope.y(), 1.0).normalized();
+    stems_.push_back({stem, anchor->id, anchor->T_map_body.inverse() * stem.position_m,
+                      anchor->T_map_body.rotation().inverse() * axis_map});
+  }
+  std::vector<trees::Stem> list;
+  for (const AnchoredStem& s : stems_) list.push_back(s.stem);
+  writeCsv(list);
+}
+
+void OnlineTrees::writeCsv(const std::vector<trees::Stem>& stems) const {
+  std::vector<trees::Stem> sorted = stems;
+  std::sort(sorted.begin(), sorted.end(), [](const trees::Stem& a, const trees::Stem& b) {
+    return a.position_m.x() != b.position_m.x() ? a.position_m.x() < b.position_m.x()
+                                                : a.position_m.y() < b.position_m.y();
+  });
+  // Written beside and renamed over: a reader never sees half a file.
+  const std::filesystem::path partial = trees_csv_.string() + ".partial";
+  trees::writeTreesCsv(partial, sorted, Eigen::Vector3d::Zero(), std::nullopt);
+  std::filesystem::rename(partial, trees_csv_);
+}
+
+std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
+  {
+    std::lock_guard lock(mutex_);
+    if (!pending_.empty()) jobs_.push_back(std::move(pending_));
+    pending_.clear();
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  std::vector<trees::Stem> list;
+  for (const AnchoredStem& s : stems_) {
+    if (s.anchor >= final_T_map_body.size()) continue;
+    const lie::SE3& T = final_T_map_body[s.anchor];
+    trees::Stem stem = s.stem;
+    const double ground_below_m = stem.position_m.z() - stem.ground_z_m;
+    stem.position_m = T * s.p_anchor;
+    stem.ground_z_m = stem.position_m.z() - ground_below_m;
+    const Eigen::Vector3d axis = T.rotation() * s.axis_anchor;
+    stem.axis_slope = axis.head<2>() / axis.z();
+    list.push_back(stem);
+  }
+  writeCsv(list);
+  return list.size();
+}
+
+double OnlineTrees::workSeconds() const {
+  std::lock_guard lock(mutex_);
+  return work_s_;
+}
+
+}  // namespace taiga::pipeline
