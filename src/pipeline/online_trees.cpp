@@ -12,7 +12,7 @@
 namespace taiga::pipeline {
 namespace {
 
-constexpr std::size_t kKeyframesPerUpdate = 10;
+constexpr std::size_t kKeyframesPerUpdate = 20;
 constexpr double kRegionKeyframes_m = 10.0;  ///< keyframes this close to a new one are loaded
 constexpr double kCropMargin_m = 20.0;       ///< points this far beyond the new keyframes are kept
 constexpr double kSeen_m = 15.0;             ///< stems this close to a new keyframe are refitted
@@ -108,23 +108,12 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
   for (const trees::Stem& stem : inventory.stems) {
     const bool seen_here = nearestFresh(stem.position_m) <= kSeen_m;
     const bool known = std::any_of(stems_.begin(), stems_.end(),
-                                   [&](const AnchoredStem& s) { return overlap(s.stem, stem); });
+                                   [&](const trees::Stem& s) { return overlap(s, stem); });
     if (known && !seen_here) continue;
-    std::erase_if(stems_, [&](const AnchoredStem& s) { return overlap(s.stem, stem); });
-    // Anchored to the nearest new keyframe (in its body frame).
-    const Keyframe* anchor = &fresh.front();
-    for (const Keyframe& k : fresh)
-      if (distanceXy(k.T_map_body.translation(), stem.position_m) <
-          distanceXy(anchor->T_map_body.translation(), stem.position_m))
-        anchor = &k;
-    const Eigen::Vector3d axis_map =
-        Eigen::Vector3d(stem.axis_slope.x(), stem.axis_slope.y(), 1.0).normalized();
-    stems_.push_back({stem, anchor->id, anchor->T_map_body.inverse() * stem.position_m,
-                      anchor->T_map_body.rotation().inverse() * axis_map});
+    std::erase_if(stems_, [&](const trees::Stem& s) { return overlap(s, stem); });
+    stems_.push_back(stem);
   }
-  std::vector<trees::Stem> list;
-  for (const AnchoredStem& s : stems_) list.push_back(s.stem);
-  writeCsv(list);
+  writeCsv(stems_);
 }
 
 void OnlineTrees::writeCsv(const std::vector<trees::Stem>& stems) const {
@@ -142,26 +131,22 @@ void OnlineTrees::writeCsv(const std::vector<trees::Stem>& stems) const {
 std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
   {
     std::lock_guard lock(mutex_);
-    if (!pending_.empty()) jobs_.push_back(std::move(pending_));
-    pending_.clear();
+    pending_.clear();  // the final pass below covers them
     stopping_ = true;
   }
   wake_.notify_all();
   if (worker_.joinable()) worker_.join();
-  std::vector<trees::Stem> list;
-  for (const AnchoredStem& s : stems_) {
-    if (s.anchor >= final_T_map_body.size()) continue;
-    const lie::SE3& T = final_T_map_body[s.anchor];
-    trees::Stem stem = s.stem;
-    const double ground_below_m = stem.position_m.z() - stem.ground_z_m;
-    stem.position_m = T * s.p_anchor;
-    stem.ground_z_m = stem.position_m.z() - ground_below_m;
-    const Eigen::Vector3d axis = T.rotation() * s.axis_anchor;
-    stem.axis_slope = axis.head<2>() / axis.z();
-    list.push_back(stem);
-  }
-  writeCsv(list);
-  return list.size();
+  // The final list: one inventory of the whole map on the graph's final poses, the same as
+  // `taiga trees RUN` on map.las. The incremental list saw each stem only from the keyframes
+  // around it at the time, on live poses (docs/trees.md, "Online").
+  std::vector<Eigen::Vector3d> points_m;
+  for (std::uint64_t id = 0; id < final_T_map_body.size() && id < store_.size(); ++id)
+    for (const Eigen::Vector3d& p_body : store_.load(id).positions)
+      points_m.push_back(final_T_map_body[id] * p_body);
+  if (points_m.empty()) return 0;
+  const trees::Inventory inventory = trees::takeInventory(points_m);
+  writeCsv(inventory.stems);
+  return inventory.stems.size();
 }
 
 double OnlineTrees::workSeconds() const {

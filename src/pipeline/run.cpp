@@ -238,7 +238,9 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
         recording_path.string(), summary.scans, summary.imu_samples));
 
   if (online_trees) {
+    const auto trees_start = Clock::now();
     summary.trees = online_trees->finish(mapper.graph().poses());
+    summary.trees_final_s = secondsSince(trees_start);
     summary.trees_work_s = online_trees->workSeconds();
   }
   const Trajectory corrected = trajectories.write(out, mapper.graph());

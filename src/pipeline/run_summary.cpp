@@ -134,7 +134,9 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"initialization", s.initialization},
       {"health", healthJson(s.health)},
   };
-  if (s.trees) j["trees_online"] = {{"stems", *s.trees}, {"worker_s", s.trees_work_s}};
+  if (s.trees)
+    j["trees_online"] = {
+        {"stems", *s.trees}, {"worker_s", s.trees_work_s}, {"final_s", s.trees_final_s}};
   if (s.realtime) {
     j["realtime"] = {{"dropped_scans", s.realtime->dropped_scans},
                      {"latency_ms",

@@ -3,25 +3,53 @@
 // BENCHMARK.md; this one is not among them.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
+#include "taiga/trees/tree_files.hpp"
 
 namespace taiga {
 namespace {
 
-TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbh) {
+TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   test::TempDir dir;
   const std::string rec = dir.file("rec").string(), run = dir.file("run").string();
   auto r = test::runTaiga("simulate --scenario handheld-loop --duration 40 --seed 21 --beams 64 "
                           "--out " + rec);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = test::runTaiga("run " + rec + "/recording.bag --config " + rec + "/rig.yaml --out " + run);
+  // The rig a user would write, with the online tree map on (mapping.trees).
+  std::ifstream rig_in(rec + "/rig.yaml");
+  std::string rig((std::istreambuf_iterator<char>(rig_in)), {});
+  const std::string off = "\n  trees: false";  // rig.yaml states every key of the mapping section
+  const std::size_t at = rig.find(off);
+  ASSERT_NE(at, std::string::npos);
+  rig.replace(at, off.size(), "\n  trees: true");
+  std::ofstream(dir.file("rig_trees.yaml")) << rig;
+  r = test::runTaiga("run " + rec + "/recording.bag --config " + dir.file("rig_trees.yaml").string() +
+                     " --out " + run);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = test::runTaiga("trees " + run);
+  ASSERT_NE(r.output.find("stems in trees.csv"), std::string::npos) << r.output;
+  // The run's trees.csv against `taiga trees` on its map.las.
+  r = test::runTaiga("trees " + run + " --out " + dir.file("offline").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto online = trees::readTreesCsv(run + "/trees.csv");
+  const auto offline = trees::readTreesCsv(dir.file("offline/trees.csv"));
+  EXPECT_NEAR(static_cast<double>(online.size()), static_cast<double>(offline.size()), 5.0);
+  double sq = 0.0;
+  std::size_t matched = 0;
+  for (const auto& a : offline)
+    for (const auto& b : online)
+      if ((a.bh_xy_m - b.bh_xy_m).norm() < 0.2) {
+        sq += (a.dbh_m - b.dbh_m) * (a.dbh_m - b.dbh_m);
+        ++matched;
+        break;
+      }
+  EXPECT_GE(matched + 5, offline.size());
+  EXPECT_LE(std::sqrt(sq / std::max<std::size_t>(1, matched)), 0.005);  // the bound
+
   r = test::runTaiga("eval --est " + run + "/trajectory.tum --ref " + rec +
                          "/groundtruth.tum --trees " + run + "/trees.csv --ref-trees " + rec +
                          "/trees.csv --json",

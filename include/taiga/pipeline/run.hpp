@@ -158,9 +158,11 @@ struct RunSummary {
   std::optional<RealtimeReport> realtime;           ///< with --realtime only
   std::optional<GeorefRunReport> georef;            ///< when the recording has GNSS fixes
   std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
-  /// With mapping.trees: the stems of the online tree map and its worker's busy time, s.
+  /// With mapping.trees: the stems in trees.csv, the worker's busy time on the live list during
+  /// the run and the final inventory's time after it, s.
   std::optional<std::size_t> trees;
   double trees_work_s = 0.0;
+  double trees_final_s = 0.0;
 };
 
 /// Runs the odometry over `recording` and writes the outputs into options.out_dir (created).
