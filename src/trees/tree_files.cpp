@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -94,11 +95,17 @@ void writeTreesGeoJson(const std::filesystem::path& path, std::span<const Stem> 
 }
 
 std::vector<TreeRecord> readTreesCsv(const std::filesystem::path& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot open the tree list", path.string()));
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  return parseTreesCsv(text, path.string());
+}
+
+std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string& source) {
+  std::istringstream in(text);
   std::string line;
   if (!std::getline(in, line))
-    throw InputError(fmt::format("{}: empty file, expected a header row", path.string()));
+    throw InputError(fmt::format("{}: empty file, expected a header row", source));
   std::map<std::string, std::size_t> column;
   const std::vector<std::string> names = splitCsv(line);
   for (std::size_t i = 0; i < names.size(); ++i) column[names[i]] = i;
@@ -110,7 +117,7 @@ std::vector<TreeRecord> readTreesCsv(const std::filesystem::path& path) {
     const auto c = find(name);
     if (!c)
       throw InputError(
-          fmt::format("{}: no column '{}' in the header '{}'", path.string(), name, line));
+          fmt::format("{}: no column '{}' in the header '{}'", source, name, line));
     return *c;
   };
   const std::size_t c_id = require("id"), c_dbh = require("dbh_m");
@@ -124,20 +131,23 @@ std::vector<TreeRecord> readTreesCsv(const std::filesystem::path& path) {
     if (line.empty() || line == "\r") continue;
     const std::vector<std::string> fields = splitCsv(line);
     if (fields.size() != names.size())
-      throw InputError(fmt::format("{}:{}: {} values, the header names {}", path.string(), number,
+      throw InputError(fmt::format("{}:{}: {} values, the header names {}", source, number,
                                    fields.size(), names.size()));
     auto number_in = [&](std::size_t c) {
       double value = 0.0;
-      const std::string& text = fields[c];
-      const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-      if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
+      const std::string& field = fields[c];
+      const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
+      if (error != std::errc() || end != field.data() + field.size() || !std::isfinite(value))
         throw InputError(fmt::format("{}:{}: column '{}': '{}' is not a finite number",
-                                     path.string(), number, names[c], text));
+                                     source, number, names[c], field));
       return value;
     };
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     TreeRecord t;
-    t.id = static_cast<long>(number_in(c_id));
+    const double id = number_in(c_id);
+    if (std::abs(id) > 1e15 || id != std::round(id))
+      throw InputError(fmt::format("{}:{}: column 'id': {} is not an integer id", source, number, id));
+    t.id = static_cast<long>(id);
     t.bh_xy_m = Eigen::Vector2d(number_in(c_x), number_in(c_y));
     t.ground_z_m = c_z ? number_in(*c_z) : kNaN;
     t.dbh_m = number_in(c_dbh);
