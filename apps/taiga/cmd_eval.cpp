@@ -208,14 +208,17 @@ Command addEvalCommand(CLI::App& tool) {
                      "A tree list (trees.csv of `taiga trees`) to score against --ref-trees");
   parser->add_option("--ref-trees", options->ref_trees,
                      "The reference tree list (e.g. a simulated recording's trees.csv)");
-  parser->add_option("--trees-radius", options->tree_options.max_path_distance_m,
-                     "Trees within this distance of the reference path are counted, m")
+  parser
+      ->add_option("--trees-radius", options->tree_options.max_path_distance_m,
+                   "Trees within this distance of the reference path are counted, m")
       ->check(CLI::PositiveNumber);
-  parser->add_option("--trees-min-dbh", options->tree_options.min_dbh_m,
-                     "Reference trees at least this thick are counted, m")
+  parser
+      ->add_option("--trees-min-dbh", options->tree_options.min_dbh_m,
+                   "Reference trees at least this thick are counted, m")
       ->check(CLI::NonNegativeNumber);
-  parser->add_option("--trees-match", options->tree_options.match_m,
-                     "A stem and a reference tree match within this distance, m")
+  parser
+      ->add_option("--trees-match", options->tree_options.match_m,
+                   "A stem and a reference tree match within this distance, m")
       ->check(CLI::PositiveNumber);
   parser->add_flag("--json", options->json, "Print JSON instead of text");
   parser->add_flag("--markdown", options->markdown, "Print Markdown tables instead of text");

@@ -115,9 +115,10 @@ int run(const RunOptions& options) {
   fmt::print("mapping    {} loop closures (loops.csv); map exported in {:.1f} s after the run\n",
              s.loop_closures, s.map_export_s);
   if (s.trees)
-    fmt::print("trees      {} stems in trees.csv (the live list's worker busy {:.1f} s during the "
-               "run; the final inventory {:.1f} s after it)\n",
-               *s.trees, s.trees_work_s, s.trees_final_s);
+    fmt::print(
+        "trees      {} stems in trees.csv (the live list's worker busy {:.1f} s during the "
+        "run; the final inventory {:.1f} s after it)\n",
+        *s.trees, s.trees_work_s, s.trees_final_s);
   if (s.realtime) {
     fmt::print(
         "realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "

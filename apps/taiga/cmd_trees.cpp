@@ -54,7 +54,8 @@ PointCloud readCloud(const fs::path& path) {
   if (ext == ".ply" || ext == ".pcd") {
     io::DecodedPoints decoded = io::readPointCloudFile(path, 0.0);
     if (decoded.dropped_invalid > 0)
-      fmt::print(stderr, "taiga trees: {}: {} points with NaN, infinite or zero coordinates skipped\n",
+      fmt::print(stderr,
+                 "taiga trees: {}: {} points with NaN, infinite or zero coordinates skipped\n",
                  path.string(), decoded.dropped_invalid);
     return std::move(decoded.cloud);
   }
@@ -76,16 +77,18 @@ int runTrees(const TreesOptions& options) {
   const bool run_dir = fs::is_directory(input);
   const fs::path map_path = run_dir ? input / "map.las" : input;
   if (run_dir && !fs::exists(map_path))
-    throw InputError(fmt::format("{}: a directory without map.las (give a run directory of `taiga "
-                                 "run`, or a LAS/PLY/PCD file)",
-                                 input.string()));
+    throw InputError(
+        fmt::format("{}: a directory without map.las (give a run directory of `taiga "
+                    "run`, or a LAS/PLY/PCD file)",
+                    input.string()));
   const fs::path out = !options.out.empty() ? fs::path(options.out)
                        : run_dir            ? input
                                             : input.parent_path();
   fs::create_directories(out.empty() ? "." : out);
 
   PointCloud cloud = readCloud(map_path);
-  if (cloud.empty()) throw InputError(fmt::format("{}: the cloud has no points", map_path.string()));
+  if (cloud.empty())
+    throw InputError(fmt::format("{}: the cloud has no points", map_path.string()));
   const Eigen::Vector3d offset_m = roundOffset(cloud.positions);
   std::vector<Eigen::Vector3d> local(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) local[i] = cloud.positions[i] - offset_m;
@@ -100,8 +103,8 @@ int runTrees(const TreesOptions& options) {
     grid = trees::GridFrame{options.epsg, Eigen::Affine3d(Eigen::Translation3d(offset_m))};
   } else if (run_dir && fs::exists(georef_yaml)) {
     const georef::GeorefGrid g = georef::readGeorefGrid(georef_yaml);
-    grid = trees::GridFrame{g.epsg,
-                            Eigen::Affine3d(g.T_epsg_world) * Eigen::Translation3d(offset_m)};
+    grid =
+        trees::GridFrame{g.epsg, Eigen::Affine3d(g.T_epsg_world) * Eigen::Translation3d(offset_m)};
   }
 
   trees::InventoryOptions io_options;
@@ -137,10 +140,11 @@ int runTrees(const TreesOptions& options) {
              partial, stems.size() - good - partial,
              grid ? fmt::format("; in EPSG:{}", grid->epsg) : "");
   if (stems.empty())
-    fmt::print("           none found: heights are measured from the lowest points of each {} m "
-               "cell, so a cloud without ground (a slice, a tree cut above its base) has no "
-               "breast height\n",
-               inventory.terrain.cellSize());
+    fmt::print(
+        "           none found: heights are measured from the lowest points of each {} m "
+        "cell, so a cloud without ground (a slice, a tree cut above its base) has no "
+        "breast height\n",
+        inventory.terrain.cellSize());
   fmt::print("outputs    {}/ (trees.csv, trees.geojson, dtm.asc{}) in {:.1f} s\n", out.string(),
              options.no_map ? "" : ", trees_map.las", seconds);
   return kExitOk;
@@ -163,16 +167,19 @@ Command addTreesCommand(CLI::App& tool) {
       ->check(CLI::Range(0.1, 5.0));
   parser->add_option("--min-dbh", options->min_dbh_m, "Thinner stems are not reported, m")
       ->check(CLI::Range(0.02, 1.0));
-  parser->add_option("--breast-height", options->breast_height_m,
-                     "Height above the ground where the DBH is measured, m")
+  parser
+      ->add_option("--breast-height", options->breast_height_m,
+                   "Height above the ground where the DBH is measured, m")
       ->check(CLI::Range(0.5, 3.0));
-  parser->add_option("--max-fit-rms", options->max_fit_rms_m,
-                     "Stem cross-sections whose points scatter more are not stems, m (2/3 of it "
-                     "for stems tracked over less than 2.7 m)")
+  parser
+      ->add_option("--max-fit-rms", options->max_fit_rms_m,
+                   "Stem cross-sections whose points scatter more are not stems, m (2/3 of it "
+                   "for stems tracked over less than 2.7 m)")
       ->check(CLI::Range(0.005, 0.2));
-  parser->add_option("--epsg", options->epsg,
-                     "The cloud's coordinates are in this projected CRS (trees.csv and "
-                     "trees.geojson carry it)")
+  parser
+      ->add_option("--epsg", options->epsg,
+                   "The cloud's coordinates are in this projected CRS (trees.csv and "
+                   "trees.geojson carry it)")
       ->check(CLI::PositiveNumber);
   parser->add_flag("--no-map", options->no_map, "Do not write the classified trees_map.las");
   return {parser, [options] { return runTrees(*options); }, options};

@@ -12,8 +12,8 @@ namespace taiga::app {
 /// Exit codes of the tool, documented in README.md.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFailure = 1,          ///< the work itself failed (e.g. a run diverged)
-  kExitBadInput = 2,         ///< bad command line, file or configuration; the message says which
+  kExitFailure = 1,   ///< the work itself failed (e.g. a run diverged)
+  kExitBadInput = 2,  ///< bad command line, file or configuration; the message says which
   /// taiga run finished and wrote every output, but lost track and did not re-attach to the
   /// map (summary.json health); taiga register's answer is not to be trusted (--strict)
   kExitTrackLost = 3,

@@ -31,9 +31,9 @@ int runTool(int argc, char** argv) {
   tool.add_flag("-q,--quiet", quiet, "Print only warnings and errors");
 
   const std::vector<Command> commands{
-      addSimulateCommand(tool), addInfoCommand(tool),   addExportCommand(tool),
-      addRegisterCommand(tool), addRunCommand(tool),    addEvalCommand(tool),
-      addCompareCommand(tool),  addGeorefCommand(tool), addConfigCommand(tool),
+      addSimulateCommand(tool),  addInfoCommand(tool),      addExportCommand(tool),
+      addRegisterCommand(tool),  addRunCommand(tool),       addEvalCommand(tool),
+      addCompareCommand(tool),   addGeorefCommand(tool),    addConfigCommand(tool),
       addExportMapCommand(tool), addCalibrateCommand(tool), addTreesCommand(tool)};
 
   try {

@@ -93,15 +93,15 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
   }
   if (report.trees) {
     const TreeAccuracy& t = *report.trees;
-    rows.push_back({"Trees (detected / reference)",
-                    fmt::format("{} / {} (DBH >= {} cm, within {} m of the path; {} against {})",
-                                t.detected, t.reference, 100 * t.options.min_dbh_m,
-                                t.options.max_path_distance_m, report.trees_file,
-                                report.ref_trees_file)});
+    rows.push_back(
+        {"Trees (detected / reference)",
+         fmt::format("{} / {} (DBH >= {} cm, within {} m of the path; {} against {})", t.detected,
+                     t.reference, 100 * t.options.min_dbh_m, t.options.max_path_distance_m,
+                     report.trees_file, report.ref_trees_file)});
     rows.push_back({"Tree detection rate (%)", fmt::format("{:.1f}", 100 * t.recall)});
-    rows.push_back({"Tree commission (%)",
-                    fmt::format("{:.1f} ({} of {} stems match no tree)", 100 * t.commission,
-                                t.false_stems, t.estimated)});
+    rows.push_back(
+        {"Tree commission (%)", fmt::format("{:.1f} ({} of {} stems match no tree)",
+                                            100 * t.commission, t.false_stems, t.estimated)});
     rows.push_back({"DBH error (cm)", fmt::format("rmse {:.2f}  bias {:+.2f}", 100 * t.dbh_rmse_m,
                                                   100 * t.dbh_bias_m)});
     rows.push_back({"Stem position RMSE (cm)", fmt::format("{:.2f}", 100 * t.position_rmse_m)});

@@ -15,8 +15,8 @@ double pathDistance(const Eigen::Vector2d& p, const std::vector<Eigen::Vector3d>
   for (std::size_t i = 0; i + 1 < path_m.size(); ++i) {
     const Eigen::Vector2d a = path_m[i].head<2>(), b = path_m[i + 1].head<2>();
     const Eigen::Vector2d ab = b - a;
-    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
-                                          : 0.0;
+    const double t =
+        ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
     best = std::min(best, (a + t * ab - p).norm());
   }
   if (path_m.size() == 1) best = (path_m[0].head<2>() - p).norm();

@@ -203,13 +203,13 @@ GeorefGrid readGeorefGrid(const std::filesystem::path& path) {
       throw InputError(fmt::format("{}: T_epsg_world: expected 4 rows", path.string()));
     for (std::size_t r = 0; r < 4; ++r) {
       if (!rows[r].IsSequence() || rows[r].size() != 4)
-        throw InputError(fmt::format("{}: T_epsg_world row {}: expected 4 numbers", path.string(), r));
+        throw InputError(
+            fmt::format("{}: T_epsg_world row {}: expected 4 numbers", path.string(), r));
       for (std::size_t c = 0; c < 4; ++c) grid.T_epsg_world(r, c) = rows[r][c].as<double>();
     }
   } catch (const YAML::Exception& e) {
-    throw InputError(
-        fmt::format("{}: epsg and T_epsg_world expected (a georef.yaml of taiga): {}", path.string(),
-                    e.what()));
+    throw InputError(fmt::format("{}: epsg and T_epsg_world expected (a georef.yaml of taiga): {}",
+                                 path.string(), e.what()));
   }
   if (!grid.T_epsg_world.allFinite())
     throw InputError(fmt::format("{}: T_epsg_world has non-finite values", path.string()));

@@ -13,9 +13,10 @@
 namespace taiga::io {
 namespace {
 
-static_assert(std::endian::native == std::endian::little, "LAS is little-endian; so is this writer's machine");
+static_assert(std::endian::native == std::endian::little,
+              "LAS is little-endian; so is this writer's machine");
 
-constexpr std::uint16_t kHeaderSize = 375;      // LAS 1.4 public header block
+constexpr std::uint16_t kHeaderSize = 375;  // LAS 1.4 public header block
 constexpr std::uint16_t kVlrHeaderSize = 54;
 constexpr std::uint8_t kPointFormat = 6;
 constexpr std::uint16_t kPointRecordSize = 30;  // format 6
@@ -43,9 +44,11 @@ class Bytes {
 
 std::int32_t toScaledInteger(double value_m, double offset_m, double scale_m) {
   const double scaled = std::round((value_m - offset_m) / scale_m);
-  if (!(scaled >= std::numeric_limits<std::int32_t>::min() && scaled <= std::numeric_limits<std::int32_t>::max())) {
-    throw InputError(fmt::format("coordinate {} m does not fit LAS's 32-bit range at scale {} m around offset {} m", value_m,
-                                 scale_m, offset_m));
+  if (!(scaled >= std::numeric_limits<std::int32_t>::min() &&
+        scaled <= std::numeric_limits<std::int32_t>::max())) {
+    throw InputError(fmt::format(
+        "coordinate {} m does not fit LAS's 32-bit range at scale {} m around offset {} m", value_m,
+        scale_m, offset_m));
   }
   return static_cast<std::int32_t>(scaled);
 }
@@ -77,8 +80,8 @@ void LasWriter::writeHeader() {
   h.putText("LASF", 4);
   h.put<std::uint16_t>(0);  // file source ID
   h.put<std::uint16_t>(kGlobalEncodingWkt);
-  h.putZeros(16);           // project GUID
-  h.put<std::uint8_t>(1);   // version 1.4
+  h.putZeros(16);          // project GUID
+  h.put<std::uint8_t>(1);  // version 1.4
   h.put<std::uint8_t>(4);
   h.putText(options_.system_identifier, 32);
   h.putText(options_.generating_software, 32);
@@ -86,7 +89,9 @@ void LasWriter::writeHeader() {
   h.put<std::uint16_t>(0);
   h.put<std::uint16_t>(kHeaderSize);
   const bool has_wkt = !options_.wkt.empty();
-  point_data_offset_ = kHeaderSize + (has_wkt ? kVlrHeaderSize + static_cast<std::uint32_t>(options_.wkt.size()) + 1 : 0);
+  point_data_offset_ =
+      kHeaderSize +
+      (has_wkt ? kVlrHeaderSize + static_cast<std::uint32_t>(options_.wkt.size()) + 1 : 0);
   h.put<std::uint32_t>(point_data_offset_);
   h.put<std::uint32_t>(has_wkt ? 1 : 0);  // number of VLRs
   h.put<std::uint8_t>(kPointFormat);
@@ -113,7 +118,8 @@ void LasWriter::writeHeader() {
     h.putText("OGC coordinate system WKT", 32);
     h.putText(options_.wkt, options_.wkt.size() + 1);
   }
-  if (h.data().size() != point_data_offset_) throw std::logic_error("LasWriter: header size mismatch");
+  if (h.data().size() != point_data_offset_)
+    throw std::logic_error("LasWriter: header size mismatch");
   out_.seekp(0);
   out_.write(h.data().data(), static_cast<std::streamsize>(h.data().size()));
 }
@@ -140,7 +146,8 @@ void LasWriter::appendRecords(const PointCloud& cloud,
     for (const Eigen::Vector3d& p : cloud.positions) lowest = lowest.cwiseMin(p);
     offset_m_ = (lowest / 1000.0).array().floor() * 1000.0;
     offset_set_ = true;
-    if (!offset_m_.allFinite()) throw InputError(fmt::format("{}: the points have non-finite coordinates", path_.string()));
+    if (!offset_m_.allFinite())
+      throw InputError(fmt::format("{}: the points have non-finite coordinates", path_.string()));
   }
   Bytes records;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -154,12 +161,14 @@ void LasWriter::appendRecords(const PointCloud& cloud,
     min_m_ = min_m_.cwiseMin(stored);
     max_m_ = max_m_.cwiseMax(stored);
     const float intensity = cloud.hasIntensities() ? cloud.intensities[i] : 0.0f;
-    records.put<std::uint16_t>(static_cast<std::uint16_t>(std::clamp(std::round(intensity), 0.0f, 65535.0f)));
+    records.put<std::uint16_t>(
+        static_cast<std::uint16_t>(std::clamp(std::round(intensity), 0.0f, 65535.0f)));
     records.put<std::uint8_t>(0x11);  // return 1 of 1
     records.put<std::uint8_t>(0);     // classification flags, scanner channel, scan direction, edge
     records.put<std::uint8_t>(classifications.empty() ? options_.classification
                                                       : classifications[i]);
-    records.put<std::uint8_t>(cloud.hasRings() ? static_cast<std::uint8_t>(std::min<int>(cloud.rings[i], 255)) : 0);
+    records.put<std::uint8_t>(
+        cloud.hasRings() ? static_cast<std::uint8_t>(std::min<int>(cloud.rings[i], 255)) : 0);
     records.put<std::int16_t>(0);  // scan angle
     records.put<std::uint16_t>(source_ids.empty() ? source_id : source_ids[i]);
     records.put<double>(cloud.hasTimes() ? cloud.times_s[i] : 0.0);

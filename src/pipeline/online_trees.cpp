@@ -84,14 +84,16 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
   }
   auto nearestFresh = [&](const Eigen::Vector3d& p) {
     double best = std::numeric_limits<double>::infinity();
-    for (const Keyframe& k : fresh) best = std::min(best, distanceXy(p, k.T_map_body.translation()));
+    for (const Keyframe& k : fresh)
+      best = std::min(best, distanceXy(p, k.T_map_body.translation()));
     return best;
   };
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   for (const Keyframe& k : fresh) center += k.T_map_body.translation();
   center /= static_cast<double>(fresh.size());
   double crop_m = 0.0;
-  for (const Keyframe& k : fresh) crop_m = std::max(crop_m, distanceXy(k.T_map_body.translation(), center));
+  for (const Keyframe& k : fresh)
+    crop_m = std::max(crop_m, distanceXy(k.T_map_body.translation(), center));
   crop_m += kCropMargin_m;
 
   std::vector<Eigen::Vector3d> points_m;
@@ -118,10 +120,7 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
 
 void OnlineTrees::writeCsv(const std::vector<trees::Stem>& stems) const {
   std::vector<trees::Stem> sorted = stems;
-  std::sort(sorted.begin(), sorted.end(), [](const trees::Stem& a, const trees::Stem& b) {
-    return a.position_m.x() != b.position_m.x() ? a.position_m.x() < b.position_m.x()
-                                                : a.position_m.y() < b.position_m.y();
-  });
+  trees::sortByPosition(sorted);
   // Written beside and renamed over: a reader never sees half a file.
   const std::filesystem::path partial = trees_csv_.string() + ".partial";
   trees::writeTreesCsv(partial, sorted, Eigen::Vector3d::Zero(), std::nullopt);
@@ -132,6 +131,7 @@ std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
   {
     std::lock_guard lock(mutex_);
     pending_.clear();  // the final pass below covers them
+    jobs_.clear();
     stopping_ = true;
   }
   wake_.notify_all();
@@ -143,10 +143,16 @@ std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
   for (std::uint64_t id = 0; id < final_T_map_body.size() && id < store_.size(); ++id)
     for (const Eigen::Vector3d& p_body : store_.load(id).positions)
       points_m.push_back(final_T_map_body[id] * p_body);
-  if (points_m.empty()) return 0;
-  const trees::Inventory inventory = trees::takeInventory(points_m);
-  writeCsv(inventory.stems);
-  return inventory.stems.size();
+  try {
+    const trees::Inventory inventory = trees::takeInventory(points_m);
+    writeCsv(inventory.stems);
+    return inventory.stems.size();
+  } catch (const InputError& e) {  // no points, or a map too large for one terrain grid
+    logger().warn("tree map: the final inventory failed ({}); trees.csv holds the live list",
+                  e.what());
+    writeCsv(stems_);
+    return stems_.size();
+  }
 }
 
 double OnlineTrees::workSeconds() const {

@@ -57,7 +57,7 @@ class OnlineTrees final : public SlamObserver {
   lie::SE3 T_map_odom_;
   std::vector<Keyframe> keyframes_;  ///< every keyframe, live poses (worker reads under mutex_)
   std::vector<Keyframe> pending_;    ///< not yet in an update
-  std::vector<trees::Stem> stems_;  ///< the incremental list, worker-owned
+  std::vector<trees::Stem> stems_;   ///< the incremental list, worker-owned
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<std::vector<Keyframe>> jobs_;

@@ -10,10 +10,10 @@
 #include <set>
 #include <vector>
 
+#include "online_trees.hpp"
 #include "recording_feed.hpp"
 #include "run_georef.hpp"
 #include "run_health.hpp"
-#include "online_trees.hpp"
 #include "run_outputs.hpp"
 #include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
@@ -179,8 +179,7 @@ std::uint64_t exportMaps(const mapping::KeyframeStore& store, const mapping::Map
   mapping::MapExportOptions attached_options = map_options;
   if (!detached.empty())
     attached_options.keep = [&](std::uint64_t id) { return mapper.attached(id); };
-  return mapping::exportMap(store, graph.poses(), out / "map.las", attached_options)
-      .points_written;
+  return mapping::exportMap(store, graph.poses(), out / "map.las", attached_options).points_written;
 }
 
 }  // namespace
@@ -215,7 +214,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   slam.addObserver(health);
   slam.addObserver(gnss);
   std::optional<OnlineTrees> online_trees;
-  if (config.mapping.trees) slam.addObserver(online_trees.emplace(slam.keyframes(), out / "trees.csv"));
+  if (config.mapping.trees)
+    slam.addObserver(online_trees.emplace(slam.keyframes(), out / "trees.csv"));
 
   RunSummary summary;
   const auto wall_start = Clock::now();

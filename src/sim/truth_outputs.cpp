@@ -67,10 +67,10 @@ void writeTreesCsv(const std::filesystem::path& path, const Scene& scene) {
   std::size_t id = 0;
   for (const Tree& t : scene.trees()) {
     const Eigen::Vector3d bh = t.axisAt(1.3);
-    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", id++, t.base_world.x(),
-                        t.base_world.y(), t.base_world.z(), t.dbh_m, t.height_m,
-                        t.lean_rad * kDegPerRad, t.lean_azimuth_rad * kDegPerRad,
-                        speciesName(t.species), bh.x(), bh.y());
+    text +=
+        fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", id++, t.base_world.x(), t.base_world.y(),
+                    t.base_world.z(), t.dbh_m, t.height_m, t.lean_rad * kDegPerRad,
+                    t.lean_azimuth_rad * kDegPerRad, speciesName(t.species), bh.x(), bh.y());
   }
   writeText(path, text);
 }
@@ -86,8 +86,10 @@ void writeGeorefTruthYaml(const std::filesystem::path& path, const Simulation& s
       path,
       fmt::format(
           "# Where the simulated world frame lies in EPSG:{} ({}).\n"
-          "# Geodetic coordinates are WGS84 = ETRS89 here (no epoch, no plate motion); heights are\n"
-          "# ellipsoidal. The world frame is the local east-north-up frame at the origin turned by\n"
+          "# Geodetic coordinates are WGS84 = ETRS89 here (no epoch, no plate motion); heights "
+          "are\n"
+          "# ellipsoidal. The world frame is the local east-north-up frame at the origin turned "
+          "by\n"
           "# world_yaw_from_east_deg about up. The grid is turned against the local frame by the\n"
           "# meridian convergence and scaled by the projection's point scale (and R / (R + h)).\n"
           "epsg: {}\n"
@@ -99,11 +101,13 @@ void writeGeorefTruthYaml(const std::filesystem::path& path, const Simulation& s
           "  easting_m: {}\n"
           "  northing_m: {}\n"
           "world_yaw_from_east_deg: {}  # angle from local east to world x, counterclockwise\n"
-          "meridian_convergence_deg: {}  # angle from grid easting to local east, counterclockwise\n"
+          "meridian_convergence_deg: {}  # angle from grid easting to local east, "
+          "counterclockwise\n"
           "yaw_grid_world_deg: {}  # angle from grid easting to world x, counterclockwise\n"
           "scale: {}  # grid metres per world metre at the origin\n"
           "# [E, N, h, 1] = T_epsg_world [x, y, z, 1], row by row: scale * Rz(yaw_grid_world_deg)\n"
-          "# horizontally, heights unscaled. The tangent-plane approximation at the origin: off by\n"
+          "# horizontally, heights unscaled. The tangent-plane approximation at the origin: off "
+          "by\n"
           "# 0.2 mm at 50 m from it and 1.8 mm at 150 m (grid curvature, Earth curvature in h).\n"
           "# For exact coordinates convert world -> geodetic -> grid (taiga::geo).\n"
           "T_epsg_world:\n{}",

@@ -74,7 +74,8 @@ double densestShare(std::span<const Vector2d> points_m, const std::vector<double
     ++total;
   }
   int best = 0;
-  for (int k = 0; k < 36; ++k) best = std::max(best, count[k] + count[(k + 1) % 36] + count[(k + 2) % 36]);
+  for (int k = 0; k < 36; ++k)
+    best = std::max(best, count[k] + count[(k + 1) % 36] + count[(k + 2) % 36]);
   return total > 0 ? static_cast<double>(best) / total : 1.0;
 }
 
@@ -93,9 +94,8 @@ double arcCoverageDeg(std::span<const Vector2d> points_m, const std::vector<doub
 
 }  // namespace
 
-std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m,
-                                      const Vector2d& center_m, double radius_m,
-                                      const CircleFitOptions& options) {
+std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const Vector2d& center_m,
+                                      double radius_m, const CircleFitOptions& options) {
   if (points_m.size() < 5) return std::nullopt;
   Circle circle{center_m, radius_m};
   const double scale_m = robustScale(points_m, circle, options.inlier_band_m);

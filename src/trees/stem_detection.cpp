@@ -3,7 +3,6 @@
 #include <tsl/robin_map.h>
 
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -185,14 +184,14 @@ Axis fitAxis(const std::vector<Slice>& slices, double breast_height_m) {
   Axis axis{solution.row(0).transpose(), solution.row(1).transpose(), 0.0};
   double sq = 0.0;
   for (const Slice& s : slices)
-    sq += (s.center_m - axis.at_breast_height - axis.slope * (s.h_m - breast_height_m))
-              .squaredNorm();
+    sq +=
+        (s.center_m - axis.at_breast_height - axis.slope * (s.h_m - breast_height_m)).squaredNorm();
   axis.rms_m = std::sqrt(sq / static_cast<double>(slices.size()));
   return axis;
 }
 
-double treeHeight(const CellMap<double>& canopy, double pixel_m,
-                  const Stem& stem, double breast_height_m) {
+double treeHeight(const CellMap<double>& canopy, double pixel_m, const Stem& stem,
+                  double breast_height_m) {
   constexpr double kRadius_m = 0.75;
   const double reach_m = kRadius_m + stem.axis_slope.norm() * 40.0;
   const Vector2d c = stem.position_m.head<2>();
@@ -220,6 +219,53 @@ bool hollow(const std::vector<Vector2d>& points_m, const CircleFit& fit) {
     return (p - fit.center_m).norm() < core_m;
   });
   return static_cast<double>(inside) <= 0.15 * static_cast<double>(fit.inliers) + 2.0;
+}
+
+// Steps 2-5 of the header for one seed circle: the slices along the stem, the axis, the DBH fit
+// and the checks that it is a stem; nothing when it is not.
+std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& terrain,
+                                const CircleFit& seed, const StemOptions& o,
+                                const CircleFitOptions& fit) {
+  const double bh = o.breast_height_m;
+  const double band_lo = bh - o.dbh_band_half_m, band_hi = bh + o.dbh_band_half_m;
+  const std::vector<Slice> slices = trackStem(index, {bh, seed.center_m, seed.radius_m}, o, fit);
+  if (slices.size() < o.min_slices) return std::nullopt;
+  const Axis axis = fitAxis(slices, bh);
+  const double lean_rad = std::atan(axis.slope.norm());
+  if (lean_rad * kDegPerRad > o.max_lean_deg) return std::nullopt;
+
+  // DBH: the band's points with the lean taken out, fitted around the axis.
+  std::vector<Vector2d> upright;
+  index.forEachNear(
+      axis.at_breast_height, seed.radius_m + 0.15 + 0.3 * axis.slope.norm(), band_lo, band_hi,
+      [&](const Vector3d& p) { upright.push_back(p.head<2>() - axis.slope * (p.z() - bh)); });
+  const std::optional<CircleFit> dbh_fit =
+      refineCircle(upright, axis.at_breast_height, seed.radius_m, fit);
+  const double max_rms_m =
+      slices.size() >= o.long_stem_slices ? o.max_fit_rms_m : 2.0 / 3.0 * o.max_fit_rms_m;
+  if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > max_rms_m ||
+      dbh_fit->densest_share > o.max_densest_share || !hollow(upright, *dbh_fit))
+    return std::nullopt;
+  const double lean_scale = 2.0 / (1.0 + 1.0 / std::cos(lean_rad));
+  Stem stem;
+  stem.dbh_m = 2.0 * dbh_fit->radius_m * lean_scale;
+  if (stem.dbh_m < o.min_dbh_m || stem.dbh_m > o.max_dbh_m) return std::nullopt;
+  stem.dbh_sigma_m = 2.0 * dbh_fit->sigma_radius_m;
+  stem.ground_z_m = terrain.heightAt(dbh_fit->center_m.x(), dbh_fit->center_m.y());
+  stem.position_m = Vector3d(dbh_fit->center_m.x(), dbh_fit->center_m.y(), stem.ground_z_m + bh);
+  stem.axis_slope = axis.slope;
+  stem.lean_deg = lean_rad * kDegPerRad;
+  stem.lean_azimuth_deg =
+      std::fmod(std::atan2(axis.slope.y(), axis.slope.x()) * kDegPerRad + 360.0, 360.0);
+  stem.points = dbh_fit->inliers;
+  stem.fit_rms_m = dbh_fit->rms_m;
+  stem.arc_deg = dbh_fit->arc_deg;
+  stem.slices = slices.size();
+  for (const Slice& s : slices) stem.top_slice_m = std::max(stem.top_slice_m, s.h_m);
+  stem.quality = stem.fit_rms_m > 0.02 || axis.rms_m > 0.03 ? StemQuality::kPoor
+                 : stem.arc_deg < 180.0                     ? StemQuality::kPartial
+                                                            : StemQuality::kGood;
+  return stem;
 }
 
 }  // namespace
@@ -269,46 +315,10 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
       std::erase_if(cluster, [&](const Vector2d& p) {
         return (p - seed->center_m).norm() < seed->radius_m + 0.1;
       });
-      const std::vector<Slice> slices = trackStem(index, {bh, seed->center_m, seed->radius_m}, o, fit);
-      if (slices.size() < o.min_slices) continue;
-      const Axis axis = fitAxis(slices, bh);
-      const double lean_rad = std::atan(axis.slope.norm());
-      if (lean_rad * kDegPerRad > o.max_lean_deg) continue;
-
-      // DBH: the band's points with the lean taken out, fitted around the axis.
-      std::vector<Vector2d> upright;
-      index.forEachNear(axis.at_breast_height, seed->radius_m + 0.15 + 0.3 * axis.slope.norm(),
-                        band_lo, band_hi, [&](const Vector3d& p) {
-                          upright.push_back(p.head<2>() - axis.slope * (p.z() - bh));
-                        });
-      const std::optional<CircleFit> dbh_fit =
-          refineCircle(upright, axis.at_breast_height, seed->radius_m, fit);
-      const double max_rms_m =
-          slices.size() >= o.long_stem_slices ? o.max_fit_rms_m : 2.0 / 3.0 * o.max_fit_rms_m;
-      if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > max_rms_m ||
-          dbh_fit->densest_share > o.max_densest_share || !hollow(upright, *dbh_fit))
-        continue;
-      const double lean_scale = 2.0 / (1.0 + 1.0 / std::cos(lean_rad));
-      Stem stem;
-      stem.dbh_m = 2.0 * dbh_fit->radius_m * lean_scale;
-      if (stem.dbh_m < o.min_dbh_m || stem.dbh_m > o.max_dbh_m) continue;
-      stem.dbh_sigma_m = 2.0 * dbh_fit->sigma_radius_m;
-      stem.ground_z_m = terrain.heightAt(dbh_fit->center_m.x(), dbh_fit->center_m.y());
-      stem.position_m = Vector3d(dbh_fit->center_m.x(), dbh_fit->center_m.y(), stem.ground_z_m + bh);
-      stem.axis_slope = axis.slope;
-      stem.lean_deg = lean_rad * kDegPerRad;
-      stem.lean_azimuth_deg = std::fmod(
-          std::atan2(axis.slope.y(), axis.slope.x()) * kDegPerRad + 360.0, 360.0);
-      stem.points = dbh_fit->inliers;
-      stem.fit_rms_m = dbh_fit->rms_m;
-      stem.arc_deg = dbh_fit->arc_deg;
-      stem.slices = slices.size();
-      for (const Slice& s : slices) stem.top_slice_m = std::max(stem.top_slice_m, s.h_m);
-      stem.quality = stem.fit_rms_m > 0.02 || axis.rms_m > 0.03 ? StemQuality::kPoor
-                     : stem.arc_deg < 180.0                    ? StemQuality::kPartial
-                                                               : StemQuality::kGood;
-      stem.height_m = std::max(stem.top_slice_m, treeHeight(canopy, kCanopyPixel_m, stem, bh));
-      candidates.push_back(stem);
+      if (std::optional<Stem> stem = measureStem(index, terrain, *seed, o, fit)) {
+        stem->height_m = std::max(stem->top_slice_m, treeHeight(canopy, kCanopyPixel_m, *stem, bh));
+        candidates.push_back(*stem);
+      }
     }
   }
 
@@ -322,11 +332,15 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
     });
     if (!overlaps) stems.push_back(c);
   }
+  sortByPosition(stems);
+  return stems;
+}
+
+void sortByPosition(std::vector<Stem>& stems) {
   std::sort(stems.begin(), stems.end(), [](const Stem& a, const Stem& b) {
     return a.position_m.x() != b.position_m.x() ? a.position_m.x() < b.position_m.x()
                                                 : a.position_m.y() < b.position_m.y();
   });
-  return stems;
 }
 
 std::vector<std::uint32_t> stemMembership(std::span<const Vector3d> points_m,

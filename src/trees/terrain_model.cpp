@@ -93,9 +93,8 @@ std::vector<bool> progressiveMorphologicalFilter(const Grid& g, const std::vecto
   int previous_window = 1;
   for (int r = 1; (2 * r + 1) * o.cell_m <= o.max_window_m || r == 1; r *= 2) {
     const int window = 2 * r + 1;
-    const double threshold_m =
-        std::min(o.max_threshold_m,
-                 o.initial_threshold_m + o.slope * (window - previous_window) * o.cell_m);
+    const double threshold_m = std::min(
+        o.max_threshold_m, o.initial_threshold_m + o.slope * (window - previous_window) * o.cell_m);
     surface = morph(g, morph(g, surface, r, true), r, false);
     for (std::size_t i = 0; i < z_min.size(); ++i)
       if (ground[i] && z_min[i] - surface[i] > threshold_m) ground[i] = false;
@@ -203,10 +202,11 @@ TerrainModel buildTerrainModel(std::span<const Eigen::Vector3d> points_m,
 void writeAsciiGrid(const std::filesystem::path& path, const TerrainModel& terrain,
                     const Eigen::Vector3d& offset_m, bool filled_as_nodata) {
   auto out = fmt::output_file(path.string());
-  out.print("ncols {}\nnrows {}\nxllcorner {:.3f}\nyllcorner {:.3f}\ncellsize {}\n"
-            "NODATA_value -9999\n",
-            terrain.nx(), terrain.ny(), terrain.origin().x() + offset_m.x(),
-            terrain.origin().y() + offset_m.y(), terrain.cellSize());
+  out.print(
+      "ncols {}\nnrows {}\nxllcorner {:.3f}\nyllcorner {:.3f}\ncellsize {}\n"
+      "NODATA_value -9999\n",
+      terrain.nx(), terrain.ny(), terrain.origin().x() + offset_m.x(),
+      terrain.origin().y() + offset_m.y(), terrain.cellSize());
   for (int iy = terrain.ny() - 1; iy >= 0; --iy) {
     for (int ix = 0; ix < terrain.nx(); ++ix) {
       const bool nodata = filled_as_nodata && !terrain.cellMeasured(ix, iy);

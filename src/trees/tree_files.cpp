@@ -8,8 +8,8 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <sstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "taiga/core/errors.hpp"
@@ -50,10 +50,12 @@ void writeTreesCsv(const std::filesystem::path& path, std::span<const Stem> stem
     const Stem& s = stems[i];
     const Eigen::Vector3d base = groundPoint(s) + offset_m;
     const Eigen::Vector3d bh = s.position_m + offset_m;
-    out.print("{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.2f},{:.2f},{:.1f},{},{:.4f},{:.0f},{},{}",
-              i + 1, base.x(), base.y(), base.z(), bh.x(), bh.y(), s.dbh_m, s.dbh_sigma_m,
-              s.height_m, s.lean_deg, s.lean_azimuth_deg, s.points, s.fit_rms_m, s.arc_deg,
-              s.slices, qualityName(s.quality));
+    out.print(
+        "{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.2f},{:.2f},{:.1f},{},{:.4f},{:.0f},"
+        "{},{}",
+        i + 1, base.x(), base.y(), base.z(), bh.x(), bh.y(), s.dbh_m, s.dbh_sigma_m, s.height_m,
+        s.lean_deg, s.lean_azimuth_deg, s.points, s.fit_rms_m, s.arc_deg, s.slices,
+        qualityName(s.quality));
     if (grid) {
       const Eigen::Vector3d bh_grid = grid->T_epsg_local * s.position_m;
       const Eigen::Vector3d ground_grid =
@@ -78,9 +80,9 @@ void writeTreesGeoJson(const std::filesystem::path& path, std::span<const Stem> 
                              {"dbh_cm", std::round(s.dbh_m * 1e3) / 10},
                              {"height_m", std::round(s.height_m * 100) / 100},
                              {"quality", qualityName(s.quality)}};
-    feature["geometry"] = {{"type", "Point"},
-                           {"coordinates", {std::round(p.x() * 1e3) / 1e3,
-                                            std::round(p.y() * 1e3) / 1e3}}};
+    feature["geometry"] = {
+        {"type", "Point"},
+        {"coordinates", {std::round(p.x() * 1e3) / 1e3, std::round(p.y() * 1e3) / 1e3}}};
     features.push_back(std::move(feature));
   }
   nlohmann::ordered_json geojson;
@@ -116,8 +118,7 @@ std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string
   auto require = [&](const char* name) {
     const auto c = find(name);
     if (!c)
-      throw InputError(
-          fmt::format("{}: no column '{}' in the header '{}'", source, name, line));
+      throw InputError(fmt::format("{}: no column '{}' in the header '{}'", source, name, line));
     return *c;
   };
   const std::size_t c_id = require("id"), c_dbh = require("dbh_m");
@@ -138,15 +139,16 @@ std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string
       const std::string& field = fields[c];
       const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
       if (error != std::errc() || end != field.data() + field.size() || !std::isfinite(value))
-        throw InputError(fmt::format("{}:{}: column '{}': '{}' is not a finite number",
-                                     source, number, names[c], field));
+        throw InputError(fmt::format("{}:{}: column '{}': '{}' is not a finite number", source,
+                                     number, names[c], field));
       return value;
     };
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     TreeRecord t;
     const double id = number_in(c_id);
     if (std::abs(id) > 1e15 || id != std::round(id))
-      throw InputError(fmt::format("{}:{}: column 'id': {} is not an integer id", source, number, id));
+      throw InputError(
+          fmt::format("{}:{}: column 'id': {} is not an integer id", source, number, id));
     t.id = static_cast<long>(id);
     t.bh_xy_m = Eigen::Vector2d(number_in(c_x), number_in(c_y));
     t.ground_z_m = c_z ? number_in(*c_z) : kNaN;

@@ -1,5 +1,7 @@
 // The realism presets: `ideal` is today's simulator bit for bit; `typical` and `harsh` put the
 // errors the rig.yaml does not state into the recording, and the truth into rig_truth.yaml.
+#include "taiga/sim/realism.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,7 +15,6 @@
 #include "taiga/io/config_yaml.hpp"
 #include "taiga/io/recording.hpp"
 #include "taiga/sim/imu.hpp"
-#include "taiga/sim/realism.hpp"
 #include "taiga/sim/scenario_yaml.hpp"
 #include "taiga/sim/simulator.hpp"
 
@@ -164,8 +165,8 @@ TEST(Realism, LostPacketsRemoveWholeBlocksOfSixteenColumns) {
   Scenario s = small("mixed", "typical");
   s.lidar.packet_loss_probability = 0.5;
   const Simulation simulation(s, 1.0, 4);
-  const io::Scan scan = simulation.lidar().simulateScan(simulation.scene(), simulation.motion(), 3,
-                                                        0.3);
+  const io::Scan scan =
+      simulation.lidar().simulateScan(simulation.scene(), simulation.motion(), 3, 0.3);
   std::set<int> packets;
   for (const std::uint16_t col : scan.cloud_in_lidar.columns) packets.insert(col / 16);
   EXPECT_GT(packets.size(), 6u);  // of 32 packets, about half are lost

@@ -67,9 +67,9 @@ TEST(TruthOutputs, TreesCsvHoldsEveryStemAtFullPrecision) {
   writeSimulation(simulation, dir.path());
   const auto rows = readCsv(dir.file("trees.csv"));
   ASSERT_EQ(rows.size(), simulation.scene().trees().size() + 1);
-  EXPECT_EQ(rows[0], (std::vector<std::string>{"id", "x_m", "y_m", "z_m", "dbh_m", "height_m",
-                                                "lean_deg", "lean_azimuth_deg", "species", "x_bh_m",
-                                                "y_bh_m"}));
+  EXPECT_EQ(rows[0],
+            (std::vector<std::string>{"id", "x_m", "y_m", "z_m", "dbh_m", "height_m", "lean_deg",
+                                      "lean_azimuth_deg", "species", "x_bh_m", "y_bh_m"}));
   for (std::size_t i = 0; i < simulation.scene().trees().size(); ++i) {
     const Tree& tree = simulation.scene().trees()[i];
     const auto& row = rows[i + 1];
@@ -142,8 +142,8 @@ TEST(TruthOutputs, GeorefTruthMapsNoiseFreeFixesOntoTheTrajectory) {
 TEST(TruthOutputs, GeorefTruthMapsNoisyFixesWithinTheSimulatedError) {
   test::TempDir dir;
   const Simulation simulation(
-      smallScenario("gnss: {rate_hz: 5, multipath_probability: 0, outage_probability: 0}\n"),
-      20.0, 3);
+      smallScenario("gnss: {rate_hz: 5, multipath_probability: 0, outage_probability: 0}\n"), 20.0,
+      3);
   writeSimulation(simulation, dir.path());
   const GnssParams& gnss = simulation.scenario().gnss;
   const double sigma_h_max = gnss.sigma_open_horizontal_m + gnss.sigma_canopy_horizontal_m;

@@ -31,8 +31,10 @@ TEST(CircleFit, APartialArcWithBranchesAndFoliageGivesTheStem) {
     // a branch leaving the stem and a ball of foliage next to it.
     std::vector<Vector2d> points = arc({2.0, 1.0}, 0.15, -1.0, 1.1, 300, 0.005, rng);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    for (int i = 0; i < 100; ++i) points.push_back(Vector2d(2.15 + 0.8 * u(rng), 1.0 + 0.02 * u(rng)));
-    for (int i = 0; i < 100; ++i) points.push_back(Vector2d(2.6, 0.5) + 0.4 * Vector2d(u(rng), u(rng)));
+    for (int i = 0; i < 100; ++i)
+      points.push_back(Vector2d(2.15 + 0.8 * u(rng), 1.0 + 0.02 * u(rng)));
+    for (int i = 0; i < 100; ++i)
+      points.push_back(Vector2d(2.6, 0.5) + 0.4 * Vector2d(u(rng), u(rng)));
     const auto fit = fitCircleRobust(points, {.seed = seed});
     ASSERT_TRUE(fit) << seed;
     EXPECT_NEAR(fit->radius_m, 0.15, 0.004) << seed;

@@ -27,8 +27,7 @@ inline std::vector<Eigen::Vector3d> syntheticForest(const std::vector<SyntheticS
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<Eigen::Vector3d> points;
   for (double x = -10; x <= 10; x += 0.1)
-    for (double y = -10; y <= 10; y += 0.1)
-      points.emplace_back(x, y, groundZ(x, y) + noise(rng));
+    for (double y = -10; y <= 10; y += 0.1) points.emplace_back(x, y, groundZ(x, y) + noise(rng));
   for (const SyntheticStem& s : stems) {
     const double ground = groundZ(s.base_xy.x(), s.base_xy.y());
     for (double h = 0.0; h < 6.0; h += 0.02)

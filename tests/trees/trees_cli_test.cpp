@@ -90,7 +90,8 @@ TEST(TreesCli, BadInputNamesTheFile) {
   r = test::runTaiga("trees " + dir.file("notes.txt").string() + out);
   EXPECT_EQ(r.exit_code, 2) << r.output;
 
-  std::ofstream(dir.file("truncated.ply")) << "ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty double x\n";
+  std::ofstream(dir.file("truncated.ply"))
+      << "ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty double x\n";
   r = test::runTaiga("trees " + dir.file("truncated.ply").string() + out);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("truncated.ply"), std::string::npos) << r.output;

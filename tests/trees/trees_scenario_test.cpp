@@ -17,8 +17,10 @@ namespace {
 TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   test::TempDir dir;
   const std::string rec = dir.file("rec").string(), run = dir.file("run").string();
-  auto r = test::runTaiga("simulate --scenario handheld-loop --duration 40 --seed 21 --beams 64 "
-                          "--out " + rec);
+  auto r = test::runTaiga(
+      "simulate --scenario handheld-loop --duration 40 --seed 21 --beams 64 "
+      "--out " +
+      rec);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // The rig a user would write, with the online tree map on (mapping.trees).
   std::ifstream rig_in(rec + "/rig.yaml");
@@ -28,8 +30,8 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   ASSERT_NE(at, std::string::npos);
   rig.replace(at, off.size(), "\n  trees: true");
   std::ofstream(dir.file("rig_trees.yaml")) << rig;
-  r = test::runTaiga("run " + rec + "/recording.bag --config " + dir.file("rig_trees.yaml").string() +
-                     " --out " + run);
+  r = test::runTaiga("run " + rec + "/recording.bag --config " +
+                     dir.file("rig_trees.yaml").string() + " --out " + run);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ASSERT_NE(r.output.find("stems in trees.csv"), std::string::npos) << r.output;
   // The run's trees.csv against `taiga trees` on its map.las.

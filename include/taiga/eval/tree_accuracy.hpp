@@ -45,8 +45,8 @@ struct TreeAccuracy {
   std::size_t estimated = 0;  ///< detected stems in the area
   std::size_t false_stems = 0;
   double recall = 0.0, commission = 0.0;
-  double dbh_rmse_m = 0.0, dbh_bias_m = 0.0;  ///< over the matched counted trees, est - ref
-  double position_rmse_m = 0.0;               ///< horizontal
+  double dbh_rmse_m = 0.0, dbh_bias_m = 0.0;        ///< over the matched counted trees, est - ref
+  double position_rmse_m = 0.0;                     ///< horizontal
   double height_rmse_m = 0.0, height_bias_m = 0.0;  ///< NaN when either file has no heights
   /// Reference trees whose breast-height circle overlaps a detected stem's (the thesis' measure).
   double overlap_ratio = 0.0;

@@ -28,14 +28,14 @@ struct CircleFitOptions {
 struct CircleFit {
   Eigen::Vector2d center_m = Eigen::Vector2d::Zero();
   double radius_m = 0.0;
-  double rms_m = 0.0;          ///< RMS of the inliers' residuals |p - c| - r
-  std::size_t inliers = 0;     ///< points with a non-zero final weight
-  double arc_deg = 0.0;        ///< angular coverage of the inliers, in 10 deg sectors
+  double rms_m = 0.0;       ///< RMS of the inliers' residuals |p - c| - r
+  std::size_t inliers = 0;  ///< points with a non-zero final weight
+  double arc_deg = 0.0;     ///< angular coverage of the inliers, in 10 deg sectors
   /// Share of the inliers in the densest 30 deg: near 1 for a ring drawn through one dense arc
   /// (a stem's visible side) and sparse clutter around it.
   double densest_share = 1.0;
-  double sigma_radius_m = 0.0; ///< 1-sigma of the radius from the weighted normal equations
-  double sigma_center_m = 0.0; ///< 1-sigma of the centre (the larger axis of its ellipse)
+  double sigma_radius_m = 0.0;  ///< 1-sigma of the radius from the weighted normal equations
+  double sigma_center_m = 0.0;  ///< 1-sigma of the centre (the larger axis of its ellipse)
 };
 
 /// The fit to `points_m` (x, y), or nothing when no circle within the radius range has at least

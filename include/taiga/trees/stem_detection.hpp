@@ -37,7 +37,8 @@ struct StemOptions {
   double slice_m = 0.3;
   double lowest_slice_m = 0.4;   ///< the butt below is often hidden by vegetation and swells
   double highest_slice_m = 4.0;  ///< slices are tracked up to here or to the crown
-  std::size_t min_slices = 5;    ///< consistent slices a stem needs, the DBH band included (1.5 m of stem)
+  std::size_t min_slices =
+      5;  ///< consistent slices a stem needs, the DBH band included (1.5 m of stem)
   double max_lean_deg = 25.0;
   double inlier_band_m = 0.025;  ///< see CircleFitOptions
   double min_arc_deg = 60.0;     ///< a DBH fit on less of the circle is not reported
@@ -67,11 +68,11 @@ struct Stem {
   double lean_deg = 0.0;
   double lean_azimuth_deg = 0.0;  ///< direction of the lean, from +x towards +y
   Eigen::Vector2d axis_slope = Eigen::Vector2d::Zero();  ///< d(x, y)/dh of the axis
-  std::size_t points = 0;  ///< inliers of the DBH fit
+  std::size_t points = 0;                                ///< inliers of the DBH fit
   double fit_rms_m = 0.0;
   double arc_deg = 0.0;
-  std::size_t slices = 0;      ///< consistent slices along the stem
-  double top_slice_m = 0.0;    ///< height of the highest consistent slice above the ground
+  std::size_t slices = 0;    ///< consistent slices along the stem
+  double top_slice_m = 0.0;  ///< height of the highest consistent slice above the ground
   StemQuality quality = StemQuality::kGood;
 
   /// The axis at height h above the ground (x, y).
@@ -84,10 +85,12 @@ struct Stem {
 std::vector<Stem> detectStems(std::span<const Eigen::Vector3d> points_m,
                               const TerrainModel& terrain, const StemOptions& options = {});
 
+/// Sorts by x, then y (the order of trees.csv).
+void sortByPosition(std::vector<Stem>& stems);
+
 /// Per point: 0 when it is on no stem, else 1 + the index of the stem whose surface it lies on
 /// (within 5 cm of the fitted cylinder, from the ground up to the highest consistent slice).
 std::vector<std::uint32_t> stemMembership(std::span<const Eigen::Vector3d> points_m,
-                                          const TerrainModel& terrain,
-                                          std::span<const Stem> stems);
+                                          const TerrainModel& terrain, std::span<const Stem> stems);
 
 }  // namespace taiga::trees

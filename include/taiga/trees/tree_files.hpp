@@ -5,8 +5,8 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <optional>
-#include <string>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "taiga/trees/stem_detection.hpp"
