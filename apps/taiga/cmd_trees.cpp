@@ -32,14 +32,8 @@ struct TreesOptions {
   bool no_map = false;
 };
 
-std::string lowerExtension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 PointCloud readCloud(const fs::path& path) {
-  const std::string ext = lowerExtension(path);
+  const std::string ext = io::lowercaseExtension(path);
   if (ext == ".las") {
     io::LasReader reader(path);
     PointCloud cloud;

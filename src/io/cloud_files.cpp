@@ -21,9 +21,15 @@ LoadedPoints& LoadedPoints::operator=(LoadedPoints&& other) noexcept {
   return *this;
 }
 
-LoadedPoints readCloudFile(const std::filesystem::path& path) {
+std::string lowercaseExtension(const std::filesystem::path& path) {
   std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return extension;
+}
+
+LoadedPoints readCloudFile(const std::filesystem::path& path) {
+  const std::string extension = lowercaseExtension(path);
   if (extension == ".pcd") return readPcd(path);
   if (extension == ".ply") return readPly(path);
   throw InputError(fmt::format("{}: unknown point-cloud format '{}'; expected .pcd or .ply", path.string(), extension));

@@ -168,8 +168,7 @@ std::vector<FolderScanFile> listFolderScans(const std::filesystem::path& dir) {
   }
   std::vector<FolderScanFile> files;
   for (const auto& entry : std::filesystem::directory_iterator(scans)) {
-    std::string extension = entry.path().extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    const std::string extension = lowercaseExtension(entry.path());
     if (!entry.is_regular_file() || (extension != ".pcd" && extension != ".ply")) continue;
     const std::optional<double> stamp = stampFromName(entry.path());
     if (!stamp) {

@@ -32,6 +32,8 @@ LoadedPoints parsePcd(const std::string& bytes);
 LoadedPoints parsePly(const std::string& bytes);
 /// PCD or PLY by extension (.pcd, .ply, case-insensitive).
 LoadedPoints readCloudFile(const std::filesystem::path& path);
+/// The file's extension in lower case, with its dot (".ply"; "" when none): how files are told apart.
+std::string lowercaseExtension(const std::filesystem::path& path);
 
 /// Reads and decodes a PCD or PLY file; `stamp_s` is the time relative per-point times count from.
 DecodedPoints readPointCloudFile(const std::filesystem::path& path, double stamp_s,
