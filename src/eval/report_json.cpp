@@ -18,6 +18,57 @@ json rpeJson(const RpeResult& rpe) {
           {"rotation_deg", detail::statisticsJson(rpe.rotation_deg)}};
 }
 
+// The tree list's scores, every match, missed tree and false stem (`--trees`); the JSON report
+// and the plot data (scripts/plot_eval.py's tree map) both carry it.
+json treesJson(const EvalReport& report) {
+  const TreeAccuracy& t = *report.trees;
+  auto classes = [](const std::vector<TreeClass>& list) {
+    json out = json::array();
+    for (const TreeClass& c : list)
+      out.push_back({{"label", c.label}, {"reference", c.reference}, {"detected", c.detected}});
+    return out;
+  };
+  auto points = [](const std::vector<Eigen::Vector2d>& list) {
+    json out = json::array();
+    for (const Eigen::Vector2d& p : list) out.push_back({p.x(), p.y()});
+    return out;
+  };
+  json matches = json::array();
+  for (const TreeMatch& m : t.matches)
+    matches.push_back({{"est_id", m.est_id},
+                       {"ref_id", m.ref_id},
+                       {"est_dbh_m", m.est_dbh_m},
+                       {"ref_dbh_m", m.ref_dbh_m},
+                       {"est_xy_m", {m.est_xy_m.x(), m.est_xy_m.y()}},
+                       {"ref_xy_m", {m.ref_xy_m.x(), m.ref_xy_m.y()}},
+                       {"position_error_m", (m.est_xy_m - m.ref_xy_m).norm()},
+                       {"path_distance_m", m.path_distance_m}});
+  return {{"trees", report.trees_file},
+          {"ref_trees", report.ref_trees_file},
+          {"match_m", t.options.match_m},
+          {"min_dbh_m", t.options.min_dbh_m},
+          {"max_path_distance_m", t.options.max_path_distance_m},
+          {"reference", t.reference},
+          {"detected", t.detected},
+          {"estimated", t.estimated},
+          {"false_stems", t.false_stems},
+          {"recall", t.recall},
+          {"commission", t.commission},
+          {"dbh_rmse_m", t.dbh_rmse_m},
+          {"dbh_bias_m", t.dbh_bias_m},
+          {"position_rmse_m", t.position_rmse_m},
+          {"height_rmse_m", t.height_rmse_m},
+          {"height_bias_m", t.height_bias_m},
+          {"overlap_ratio", t.overlap_ratio},
+          {"by_dbh", classes(t.by_dbh)},
+          {"by_distance", classes(t.by_distance)},
+          {"missed_ref_ids", t.missed_ids},
+          {"false_est_ids", t.false_ids},
+          {"missed_xy_m", points(t.missed_xy_m)},
+          {"false_xy_m", points(t.false_xy_m)},
+          {"matches", std::move(matches)}};
+}
+
 }  // namespace
 
 std::string formatEvalJson(const EvalReport& report) {
@@ -76,47 +127,7 @@ std::string formatEvalJson(const EvalReport& report) {
         {"mean_m", m.mean_m},         {"median_m", m.median_m},
         {"p95_m", m.p95_m},           {"fraction_beyond_cap", m.fraction_beyond_cap}};
   }
-  if (report.trees) {
-    const TreeAccuracy& t = *report.trees;
-    auto classes = [](const std::vector<TreeClass>& list) {
-      json out = json::array();
-      for (const TreeClass& c : list)
-        out.push_back({{"label", c.label}, {"reference", c.reference}, {"detected", c.detected}});
-      return out;
-    };
-    j["trees"] = {{"trees", report.trees_file},
-                  {"ref_trees", report.ref_trees_file},
-                  {"match_m", t.options.match_m},
-                  {"min_dbh_m", t.options.min_dbh_m},
-                  {"max_path_distance_m", t.options.max_path_distance_m},
-                  {"reference", t.reference},
-                  {"detected", t.detected},
-                  {"estimated", t.estimated},
-                  {"false_stems", t.false_stems},
-                  {"recall", t.recall},
-                  {"commission", t.commission},
-                  {"dbh_rmse_m", t.dbh_rmse_m},
-                  {"dbh_bias_m", t.dbh_bias_m},
-                  {"position_rmse_m", t.position_rmse_m},
-                  {"height_rmse_m", t.height_rmse_m},
-                  {"height_bias_m", t.height_bias_m},
-                  {"overlap_ratio", t.overlap_ratio},
-                  {"by_dbh", classes(t.by_dbh)},
-                  {"by_distance", classes(t.by_distance)},
-                  {"missed_ref_ids", t.missed_ids},
-                  {"false_est_ids", t.false_ids}};
-    json matches = json::array();
-    for (const TreeMatch& m : t.matches)
-      matches.push_back({{"est_id", m.est_id},
-                         {"ref_id", m.ref_id},
-                         {"est_dbh_m", m.est_dbh_m},
-                         {"ref_dbh_m", m.ref_dbh_m},
-                         {"est_xy_m", {m.est_xy_m.x(), m.est_xy_m.y()}},
-                         {"ref_xy_m", {m.ref_xy_m.x(), m.ref_xy_m.y()}},
-                         {"position_error_m", (m.est_xy_m - m.ref_xy_m).norm()},
-                         {"path_distance_m", m.path_distance_m}});
-    j["trees"]["matches"] = std::move(matches);
-  }
+  if (report.trees) j["trees"] = treesJson(report);
   return detail::dump(j);
 }
 
@@ -132,29 +143,7 @@ std::string formatEvalPlotData(const EvalReport& report) {
   j["ape_m"] = r.ape.translation_error_m;
   if (report.timing_table && report.timing)
     j["timing"] = detail::timingSeriesJson(*report.timing_table, *report.timing);
-  if (report.trees) {
-    const TreeAccuracy& t = *report.trees;
-    auto points = [](const std::vector<Eigen::Vector2d>& list) {
-      json out = json::array();
-      for (const Eigen::Vector2d& p : list) out.push_back({p.x(), p.y()});
-      return out;
-    };
-    json matches = json::array();
-    for (const TreeMatch& m : t.matches)
-      matches.push_back({{"ref_xy_m", {m.ref_xy_m.x(), m.ref_xy_m.y()}},
-                         {"est_dbh_m", m.est_dbh_m},
-                         {"ref_dbh_m", m.ref_dbh_m},
-                         {"path_distance_m", m.path_distance_m}});
-    j["trees"] = {{"matches", std::move(matches)},
-                  {"missed_xy_m", points(t.missed_xy_m)},
-                  {"false_xy_m", points(t.false_xy_m)},
-                  {"recall", t.recall},
-                  {"commission", t.commission},
-                  {"dbh_rmse_m", t.dbh_rmse_m},
-                  {"dbh_bias_m", t.dbh_bias_m},
-                  {"min_dbh_m", t.options.min_dbh_m},
-                  {"max_path_distance_m", t.options.max_path_distance_m}};
-  }
+  if (report.trees) j["trees"] = treesJson(report);  // for the tree map, trees.png
   return detail::dump(j);
 }
 
