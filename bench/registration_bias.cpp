@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <span>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -60,6 +61,10 @@ struct Options {
   double range_scale = 1.0;     ///< every range multiplied by this
   double range_offset_m = 0.0;  ///< and this added
   bool world_voxels = false;    ///< voxel grids fixed in the world (true pose), not the body
+  /// Each voxel's point: centroid, measured (the return nearest the centroid) or raw (no voxels).
+  std::string source_sample = "centroid", map_sample = "centroid";
+  double source_noise_m = 0.0, map_noise_m = 0.0;  ///< added 1-sigma range noise (diagnosis)
+  bool reverse = false;  ///< also register the map (as source) to the scan (as target)
 };
 
 struct TrueScan {
@@ -68,12 +73,19 @@ struct TrueScan {
   std::vector<Eigen::Vector3d> map_in_body;     ///< 0.2 m voxels, as keyframes enter the map
 };
 
+std::vector<Eigen::Vector3d> representatives(const PointCloud& cloud, double voxel_m,
+                                             const std::string& mode) {
+  if (mode == "raw") return cloud.positions;
+  return preprocess::voxelFilter(cloud, voxel_m, preprocess::voxelRepresentative(mode)).positions;
+}
+
 std::vector<Eigen::Vector3d> voxelCentroids(const PointCloud& cloud_in_body, double voxel_m,
-                                            const lie::SE3& T_world_body, bool world_grid) {
-  if (!world_grid) return preprocess::voxelFilter(cloud_in_body, voxel_m).positions;
+                                            const lie::SE3& T_world_body, bool world_grid,
+                                            const std::string& mode) {
+  if (!world_grid) return representatives(cloud_in_body, voxel_m, mode);
   PointCloud in_world;
   for (const Eigen::Vector3d& p : cloud_in_body.positions) in_world.positions.push_back(T_world_body * p);
-  std::vector<Eigen::Vector3d> centroids = preprocess::voxelFilter(in_world, voxel_m).positions;
+  std::vector<Eigen::Vector3d> centroids = representatives(in_world, voxel_m, mode);
   const lie::SE3 T_body_world = T_world_body.inverse();
   for (Eigen::Vector3d& p : centroids) p = T_body_world * p;
   return centroids;
@@ -84,16 +96,25 @@ std::vector<TrueScan> readTrueScans(const Options& o, const SystemConfig& config
   io::Recording recording =
       io::openRecording(o.sim_dir + "/recording.bag", config.recording, config.rig);
   std::vector<TrueScan> scans;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal;
   while (auto event = recording.next()) {
     const auto* scan = std::get_if<io::Scan>(&*event);
     if (scan == nullptr || !truth.covers(scan->t_start_s) || !truth.covers(scan->t_end_s)) continue;
     PointCloud in_lidar = preprocess::keepRange(scan->cloud_in_lidar, 1.0, 80.0);
     for (Eigen::Vector3d& p : in_lidar.positions) p *= o.range_scale + o.range_offset_m / p.norm();
-    const PointCloud in_body =
-        preprocess::deskew(in_lidar, config.rig.T_body_lidar, truth, scan->t_end_s).cloud_in_body;
+    const auto inBody = [&](double noise_m) {
+      PointCloud noisy = in_lidar;
+      for (Eigen::Vector3d& p : noisy.positions) p += noise_m * normal(rng) * p.normalized();
+      return preprocess::deskew(noisy, config.rig.T_body_lidar, truth, scan->t_end_s)
+          .cloud_in_body;
+    };
     const lie::SE3 T_world_body = truth.poseAt(scan->t_end_s);
-    scans.push_back({T_world_body, voxelCentroids(in_body, 0.4, T_world_body, o.world_voxels),
-                     voxelCentroids(in_body, 0.2, T_world_body, o.world_voxels)});
+    scans.push_back({T_world_body,
+                     voxelCentroids(inBody(o.source_noise_m), 0.4, T_world_body, o.world_voxels,
+                                    o.source_sample),
+                     voxelCentroids(inBody(o.map_noise_m), 0.2, T_world_body, o.world_voxels,
+                                    o.map_sample)});
   }
   return scans;
 }
@@ -144,6 +165,15 @@ double mean(const std::vector<double>& v) {
   return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
 }
 
+/// Direction of travel at scan i, horizontal: from the previous scan's true position to the next
+/// one's; zero when standing still.
+Eigen::Vector3d forwardOf(const std::vector<TrueScan>& scans, std::size_t i) {
+  Eigen::Vector3d forward =
+      scans[i + 1].T_world_body.translation() - scans[i - 1].T_world_body.translation();
+  forward.z() = 0.0;
+  return forward.norm() < 0.05 ? Eigen::Vector3d::Zero() : forward.normalized();
+}
+
 /// Each scan from its true pose against a map of true keyframe poses: the error's mean along the
 /// direction of travel, across it and up.
 void measureBias(const Options& o, const std::vector<TrueScan>& scans) {
@@ -152,7 +182,7 @@ void measureBias(const Options& o, const std::vector<TrueScan>& scans) {
     const Eigen::Vector3d last = scans[keyframes.back()].T_world_body.translation();
     if ((scans[i].T_world_body.translation() - last).norm() >= 1.0) keyframes.push_back(i);
   }
-  std::vector<double> along_m, across_m, up_m;
+  std::vector<double> along_m, across_m, up_m, reverse_along_m;
   for (std::size_t i = 1; i + 1 < scans.size(); i += o.every) {
     std::vector<std::size_t> chosen;
     for (std::size_t k : keyframes)
@@ -172,18 +202,25 @@ void measureBias(const Options& o, const std::vector<TrueScan>& scans) {
       if (p.z() >= o.source_min_z_m && p.z() <= o.source_max_z_m &&
           p.norm() >= o.source_min_range_m && p.norm() <= o.source_max_range_m)
         source.push_back(p);
-    const auto result =
-        align(o, source,
-              mapInWorld(scans, chosen, T_world_keyframe, scan.T_world_body.translation(),
-                         o.max_view_angle_deg),
-              scan.T_world_body);
+    const std::vector<Eigen::Vector3d> map_in_world =
+        mapInWorld(scans, chosen, T_world_keyframe, scan.T_world_body.translation(),
+                   o.max_view_angle_deg);
+    auto result = align(o, source, map_in_world, scan.T_world_body);
     if (!result.converged) continue;
-    // Direction of travel: from the previous scan's true position to the next one's.
-    Eigen::Vector3d forward =
-        scans[i + 1].T_world_body.translation() - scans[i - 1].T_world_body.translation();
-    forward.z() = 0.0;
-    if (forward.norm() < 0.05) continue;  // standing still
-    forward.normalize();
+    if (o.reverse) {
+      // The map, thinned to the source's 0.4 m, as the source; the scan's map points as target.
+      PointCloud map_cloud;
+      map_cloud.positions = map_in_world;
+      const auto reverse =
+          align(o, preprocess::voxelFilter(map_cloud, 0.4).positions, scan.map_in_body,
+                scan.T_world_body.inverse());
+      if (!reverse.converged) continue;
+      reverse_along_m.push_back((reverse.T_target_source.inverse().translation() -
+                                 scan.T_world_body.translation())
+                                    .dot(forwardOf(scans, i)));
+    }
+    const Eigen::Vector3d forward = forwardOf(scans, i);
+    if (forward.isZero()) continue;  // standing still
     const Eigen::Vector3d error_world =
         result.T_target_source.translation() - scan.T_world_body.translation();
     along_m.push_back(error_world.dot(forward));
@@ -195,6 +232,9 @@ void measureBias(const Options& o, const std::vector<TrueScan>& scans) {
               o.method.c_str(), o.num_keyframes, o.map_ahead ? "ahead of" : "behind",
               o.skip_keyframes, o.resolution_m, along_m.size(), 1e3 * mean(along_m),
               1e3 * mean(across_m), 1e3 * mean(up_m));
+  if (o.reverse)
+    std::printf("map registered to the scan: error along travel %+.2f mm\n",
+                1e3 * mean(reverse_along_m));
 }
 
 /// A lidar-only odometry with exact deskew: prediction from the true relative motion, a map of
@@ -294,6 +334,11 @@ int main(int argc, char** argv) {
   app.add_option("--range-scale", o.range_scale, "multiply every range (diagnosis)");
   app.add_option("--range-offset", o.range_offset_m, "add to every range, m (diagnosis)");
   app.add_flag("--world-voxels", o.world_voxels, "voxel grids fixed in the world (diagnosis)");
+  app.add_option("--source-sample", o.source_sample, "centroid | measured | raw (0.4 m voxels)");
+  app.add_option("--map-sample", o.map_sample, "centroid | measured | raw (0.2 m voxels)");
+  app.add_option("--source-noise", o.source_noise_m, "add range noise to the source, 1-sigma m");
+  app.add_option("--map-noise", o.map_noise_m, "add range noise to the map points, 1-sigma m");
+  app.add_flag("--reverse", o.reverse, "also register the map to the scan (bias)");
   CLI11_PARSE(app, argc, argv);
   if (o.every < 1 || o.num_keyframes < 1 || o.skip_keyframes < 0) {
     std::fprintf(stderr, "--every and --keyframes must be >= 1, --skip >= 0\n");

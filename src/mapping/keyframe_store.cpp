@@ -16,9 +16,10 @@ namespace {
 constexpr const char* kPosesFile = "poses.tum";
 
 std::shared_ptr<const PointCloud> registrationCopy(const PointCloud& cloud_in_body,
-                                                   double voxel_m) {
-  if (voxel_m <= 0.0) return std::make_shared<const PointCloud>();
-  const PointCloud filtered = preprocess::voxelFilter(cloud_in_body, voxel_m);
+                                                   const KeyframeStoreOptions& options) {
+  if (options.registration_voxel_m <= 0.0) return std::make_shared<const PointCloud>();
+  const PointCloud filtered = preprocess::voxelFilter(
+      cloud_in_body, options.registration_voxel_m, options.registration_voxel_point);
   // Registration needs positions only. A fresh vector of the exact size: the filter's own keeps
   // the capacity it grew to (up to twice its size), and up to registration_cache_keyframes
   // copies stay in RAM.
@@ -163,7 +164,7 @@ std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_odom_body,
     // The newest keyframe is the one loop closure asks for next: cache its copy now, from the
     // scan at hand, rather than read the file back.
     std::shared_ptr<const PointCloud> registration =
-        registrationCopy(cloud_in_body, impl_->options.registration_voxel_m);
+        registrationCopy(cloud_in_body, impl_->options);
     const std::lock_guard cache_lock(impl_->cache_mutex);
     impl_->registration_cache.insert(id, std::move(registration));
   }
@@ -197,8 +198,7 @@ PointCloud KeyframeStore::load(std::uint64_t id) const {
 
 std::shared_ptr<const PointCloud> KeyframeStore::registrationCloud(std::uint64_t id) const {
   info(id);  // OutOfRangeError for an unknown id
-  const double voxel_m = impl_->options.registration_voxel_m;
-  if (voxel_m <= 0.0) return std::make_shared<const PointCloud>();
+  if (impl_->options.registration_voxel_m <= 0.0) return std::make_shared<const PointCloud>();
   {
     const std::lock_guard cache_lock(impl_->cache_mutex);
     if (std::shared_ptr<const PointCloud> cached = impl_->registration_cache.find(id)) {
@@ -209,7 +209,7 @@ std::shared_ptr<const PointCloud> KeyframeStore::registrationCloud(std::uint64_t
   // Rebuilt outside the lock, so that readers of cached keyframes go on. The file holds the scan
   // add() filtered, bit for bit, and the filter is deterministic: the same copy as add() made.
   // Two threads missing the same keyframe both rebuild it; either result is the same.
-  std::shared_ptr<const PointCloud> rebuilt = registrationCopy(load(id), voxel_m);
+  std::shared_ptr<const PointCloud> rebuilt = registrationCopy(load(id), impl_->options);
   const std::lock_guard cache_lock(impl_->cache_mutex);
   ++impl_->registration_copies_rebuilt;
   return impl_->registration_cache.insert(id, std::move(rebuilt));

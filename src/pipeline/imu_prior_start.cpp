@@ -64,7 +64,10 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
     const lie::SE3 T_odom_first = poseOf(at_first_end);
     for (Eigen::Vector3d& p : target_in_odom) p = T_odom_first * p;
     const registration::RegistrationResult r = registration::alignNdt(
-        preprocess::voxelFilter(second_in_body, config_.voxel_size_m).positions, target_in_odom,
+        preprocess::voxelFilter(second_in_body, config_.voxel_size_m,
+                                preprocess::voxelRepresentative(config_.voxel_point))
+            .positions,
+        target_in_odom,
         poseOf(over_second.back().state), ndt);
     if (r.num_inliers == 0 || !std::isfinite(r.hessian_condition)) {
       logger().warn(

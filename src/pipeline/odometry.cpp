@@ -127,7 +127,9 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
 
   // 3. Voxel filter.
   auto stage = Clock::now();
-  const PointCloud source_cloud = preprocess::voxelFilter(cloud_in_body, config_.voxel_size_m);
+  const PointCloud source_cloud =
+      preprocess::voxelFilter(cloud_in_body, config_.voxel_size_m,
+                              preprocess::voxelRepresentative(config_.voxel_point));
   outcome.source_points = source_cloud.size();
   outcome.timing.filter_ms = msSince(stage);
 

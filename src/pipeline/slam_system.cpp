@@ -39,7 +39,10 @@ SlamSystem::SlamSystem(const SystemConfig& config, SlamOptions options)
       // Keyframe scans go to disk in the body frame as they are made (memory stays flat); only
       // the registration-resolution copy that loop closure registers stays in RAM.
       store_(mapping::KeyframeStore::create(
-          options.keyframe_dir, {.registration_voxel_m = config.odometry.voxel_size_m})),
+          options.keyframe_dir,
+          {.registration_voxel_m = config.odometry.voxel_size_m,
+           .registration_voxel_point =
+               preprocess::voxelRepresentative(config.odometry.voxel_point)})),
       mapping_thread_(config.mapping, config.odometry, store_,
                       mappingThreadOptions(config, options, store_)),
       correction_(std::make_unique<OdometryCorrection>(

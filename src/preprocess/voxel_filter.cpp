@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <tsl/robin_map.h>
@@ -29,7 +30,8 @@ std::uint64_t voxelKey(const Eigen::Vector3d& p, double inverse_size) {
 
 }  // namespace
 
-PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m) {
+PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m,
+                       VoxelRepresentative representative) {
   if (!(voxel_size_m > 0.0))
     throw std::invalid_argument("voxelFilter: voxel_size_m must be positive");
   const double inverse_size = 1.0 / voxel_size_m;
@@ -79,9 +81,16 @@ PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m) {
     centroids.push_back(cell.sum);
     representatives.push_back(cell.nearest);
   }
-  PointCloud filtered = cloud.select(representatives);
-  filtered.positions = std::move(centroids);
+  PointCloud filtered = cloud.select(representatives);  // positions: the nearest returns
+  if (representative == VoxelRepresentative::centroid) filtered.positions = std::move(centroids);
   return filtered;
+}
+
+VoxelRepresentative voxelRepresentative(std::string_view name) {
+  if (name == "centroid") return VoxelRepresentative::centroid;
+  if (name == "measured") return VoxelRepresentative::measured;
+  throw std::invalid_argument("voxel representative must be centroid or measured, not '" +
+                              std::string(name) + "'");
 }
 
 }  // namespace taiga::preprocess

@@ -35,8 +35,12 @@ inline std::vector<Eigen::Vector3d> forestInWorld(unsigned seed,
   };
   std::vector<Eigen::Vector3d> points_in_world;
   const double half = options.half_size_m;
-  for (double x_m = -half; x_m <= half; x_m += options.ground_spacing_m)
-    for (double y_m = -half; y_m <= half; y_m += options.ground_spacing_m)
+  // The grid is offset by a fraction of its spacing: on whole metres, its points would sit
+  // exactly on the faces of NDT cells and voxels, where a registered point changes cell with the
+  // last bit of its coordinates (no real scan is so regular).
+  const double offset_m = 0.37 * options.ground_spacing_m;
+  for (double x_m = -half + offset_m; x_m <= half; x_m += options.ground_spacing_m)
+    for (double y_m = -half + offset_m; y_m <= half; y_m += options.ground_spacing_m)
       points_in_world.emplace_back(x_m, y_m, ground_z_m(x_m, y_m));
   for (int s = 0; s < options.stems; ++s) {
     const double x_m = -half + 2.0 * half * uniform(rng);

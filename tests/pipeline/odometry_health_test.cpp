@@ -43,7 +43,12 @@ struct Walk {
 template <class Replace>
 Walk walk(int scans, Replace replace) {
   const std::vector<Eigen::Vector3d> trees = forest::forestInWorld(3, {.ground_spacing_m = 0.25});
-  Odometry odometry(OdometryConfig{}, RigConfig{}, /*lidar_only=*/true);
+  // Every scan of this world holds the same exact lattice points (a subset of them): with the
+  // measured voxel points a scan finds its points' twins in the map, which no sensor gives, and
+  // the fitness swings 6x between keyframes. The health checks are tested on centroids.
+  OdometryConfig config;
+  config.voxel_point = "centroid";
+  Odometry odometry(config, RigConfig{}, /*lidar_only=*/true);
   Walk w;
   for (int k = 0; k < scans; ++k) {
     const auto index = static_cast<std::uint64_t>(k);

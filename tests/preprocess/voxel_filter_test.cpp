@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -64,6 +65,32 @@ TEST(VoxelFilter, KeepsTheChannelsOfThePointNearestTheCentroid) {
   ASSERT_EQ(filtered.size(), 1u);
   EXPECT_DOUBLE_EQ(filtered.times_s[0], 7.0);
   EXPECT_FLOAT_EQ(filtered.intensities[0], 2.0f);
+}
+
+TEST(VoxelFilter, TheMeasuredRepresentativeLiesOnACurvedSurfaceWhereTheCentroidDoesNot) {
+  // The half of a 10 cm radius stem facing a sensor on the -x side, in one 0.4 m voxel: the
+  // centroid is 2r/pi = 6.4 cm from the axis toward the sensor, 3.6 cm inside the bark.
+  const Eigen::Vector3d axis(0.2, 0.2, 0.2);
+  std::vector<Eigen::Vector3d> arc;
+  for (int i = 0; i <= 180; ++i) {
+    const double phi = (90.0 + i) * M_PI / 180.0;
+    arc.push_back(axis + 0.1 * Eigen::Vector3d(std::cos(phi), std::sin(phi), 0.0));
+  }
+  const PointCloud cloud = cloudOf(arc);
+  const auto radius = [&](const PointCloud& filtered) {
+    EXPECT_EQ(filtered.size(), 1u);
+    return (filtered.positions[0] - axis).head<2>().norm();
+  };
+  EXPECT_NEAR(radius(voxelFilter(cloud, 0.4)), 0.2 / M_PI, 1e-3);
+  const PointCloud measured = voxelFilter(cloud, 0.4, VoxelRepresentative::measured);
+  EXPECT_NEAR(radius(measured), 0.1, 1e-12);
+  EXPECT_EQ(measured.times_s[0], 90.0);  // the point facing the sensor, its own channels
+}
+
+TEST(VoxelFilter, RepresentativesByName) {
+  EXPECT_EQ(voxelRepresentative("centroid"), VoxelRepresentative::centroid);
+  EXPECT_EQ(voxelRepresentative("measured"), VoxelRepresentative::measured);
+  EXPECT_THROW(voxelRepresentative("median"), std::invalid_argument);
 }
 
 TEST(VoxelFilter, RejectsANonPositiveSizeAndAcceptsAnEmptyCloud) {

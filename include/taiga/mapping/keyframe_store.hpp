@@ -28,6 +28,7 @@
 #include "taiga/core/point_cloud.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/lie/se3.hpp"
+#include "taiga/preprocess/voxel_filter.hpp"
 
 namespace taiga::mapping {
 
@@ -35,6 +36,9 @@ struct KeyframeStoreOptions {
   /// > 0: registrationCloud() gives a copy of each scan filtered to this voxel size, m. The
   /// odometry registers at 0.4 m (thesis 3.1.1). 0: no copies, registrationCloud() is empty.
   double registration_voxel_m = 0.0;
+  /// The point standing for each voxel of the copies (OdometryConfig::voxel_point).
+  preprocess::VoxelRepresentative registration_voxel_point =
+      preprocess::VoxelRepresentative::centroid;
   /// How many registration copies stay in RAM (least recently used evicted; the others are
   /// rebuilt from disk when asked for). A loop attempt uses the current keyframe's copy and
   /// 2 x loop_submap_keyframes + 1 around the candidate (21 by default): 64 keeps those and the

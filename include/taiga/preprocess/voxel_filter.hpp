@@ -5,13 +5,25 @@
 // The output is ordered by voxel key and does not depend on the input order within a voxel or
 // on threads, so runs are repeatable.
 
+#include <string_view>
+
 #include "taiga/core/point_cloud.hpp"
 
 namespace taiga::preprocess {
 
-/// Centroid per voxel of edge `voxel_size_m` (> 0); the other channels (time, intensity, ring,
-/// column) are taken from the voxel's point nearest to the centroid. Points with non-finite
-/// coordinates are dropped.
-PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m);
+/// Which point stands for a voxel's points.
+enum class VoxelRepresentative {
+  centroid,  ///< their mean: least noisy, but inside a curved surface (a stem's arc, a hummock)
+  measured,  ///< the return nearest to that mean: on the surface (docs/registration.md, "Bias")
+};
+
+/// One point per voxel of edge `voxel_size_m` (> 0), the centroid or the measured return nearest
+/// to it; the other channels (time, intensity, ring, column) are taken from that nearest return.
+/// Points with non-finite coordinates are dropped.
+PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m,
+                       VoxelRepresentative representative = VoxelRepresentative::centroid);
+
+/// "centroid" or "measured" (OdometryConfig::voxel_point); throws std::invalid_argument else.
+VoxelRepresentative voxelRepresentative(std::string_view name);
 
 }  // namespace taiga::preprocess
