@@ -71,9 +71,6 @@ class ImuPrior final : public MotionPrior {
   std::optional<imu::Preintegrator> preintegrated_;
   std::string initialization_note_;
   bool levelled_ = false;
-  /// The accelerometer bias and its covariance at the start, restored when the frame is levelled
-  /// (levelFrame explains why).
-  backend::StateEstimate initial_estimate_;
   std::vector<double> alignment_times_;
   std::vector<lie::SE3> alignment_poses_;
   std::vector<imu::Preintegrator> alignment_increments_;

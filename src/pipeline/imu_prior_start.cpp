@@ -93,7 +93,6 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
   estimate.covariance = init.covariance;
   estimate.covariance.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() * 0.2 * 0.2;
   smoother_.initialize(estimate);
-  initial_estimate_ = estimate;
 
   FirstScan out{.index = first.index,
                 .t_s = first.t_end_s,
@@ -115,10 +114,7 @@ std::optional<lie::SE3> ImuPrior::collectForAlignment(double t_s, const lie::SE3
 
 std::optional<lie::SE3> ImuPrior::levelFrame() {
   const imu::GravityAlignment a =
-      imu::alignGravity(alignment_poses_, alignment_increments_, config_.imu.gravity_mps2,
-                        {.mean_mps2 = initial_estimate_.bias.accel_mps2,
-                         .sigma_mps2 = std::sqrt(
-                             initial_estimate_.covariance.block<3, 3>(9, 9).trace() / 3.0)});
+      imu::alignGravity(alignment_poses_, alignment_increments_, config_.imu.gravity_mps2);
   alignment_times_.clear();
   alignment_poses_.clear();
   alignment_increments_.clear();
@@ -144,14 +140,6 @@ std::optional<lie::SE3> ImuPrior::levelFrame() {
   levelled.covariance.block<6, 15>(0, 0).setZero();
   levelled.covariance.block<3, 9>(6, 6).setZero();
   levelled.covariance.block<9, 3>(6, 6).setZero();
-  // Before levelling, the smoother explained the wrongly levelled gravity's horizontal part
-  // (g sin(tilt): 0.6 m/s^2 at 3.8 deg) partly as accelerometer bias. Kept, that bias would tilt
-  // the levelled state by as much again (2.5 deg on dense_spruce seed 3, docs/odometry.md): the
-  // alignment's bias replaces it, with the start's uncertainty.
-  levelled.bias.accel_mps2 = a.accel_bias_mps2;
-  levelled.covariance.block<3, 15>(9, 0).setZero();
-  levelled.covariance.block<15, 3>(0, 9).setZero();
-  levelled.covariance.block<3, 3>(9, 9) = initial_estimate_.covariance.block<3, 3>(9, 9);
   const double tilt_sigma = 0.3 * kRadPerDeg;
   levelled.covariance.diagonal().head<9>() << Eigen::Vector3d::Constant(1e-6),
       tilt_sigma * tilt_sigma, tilt_sigma * tilt_sigma, 1e-6,
