@@ -80,11 +80,11 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.field("min_range_m", min_range_m, "m, returns closer to the lidar are dropped (operator, rig)");
   v.field("max_range_m", max_range_m, "m, returns farther from the lidar are dropped");
   v.field("voxel_size_m", voxel_size_m, "m, voxel filter of the scan registered to the local map");
-  static constexpr std::array<std::string_view, 2> kVoxelPoints{"measured", "centroid"};
+  static constexpr std::array<std::string_view, 2> kVoxelPoints{"centroid", "measured"};
   v.choice("voxel_point", voxel_point, kVoxelPoints,
-           "the point that stands for each voxel of the registered scan: measured (the return "
-           "nearest the voxel's mean) or centroid (inside curved surfaces: a smaller trajectory, "
-           "docs/registration.md, Bias)");
+           "the point that stands for each voxel of the registered scan: centroid, or measured "
+           "(the return nearest the voxel's mean: less shrink of the trajectory, but not yet "
+           "robust in re-attachment; docs/registration.md, Bias)");
   static constexpr std::array<std::string_view, 3> kImuUses{"auto", "lidar_inertial", "lidar_only"};
   v.choice(
       "imu_use", imu_use, kImuUses,

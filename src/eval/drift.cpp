@@ -5,6 +5,8 @@
 #include <cassert>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include "taiga/core/errors.hpp"
 #include "taiga/eval/alignment.hpp"
 #include "taiga/eval/statistics.hpp"
@@ -19,6 +21,19 @@ DriftResult computeDrift(const std::vector<StampedPose>& est, const std::vector<
   const Eigen::Vector3d p_est_last = origin.T_ref_est * est.back().pose.translation();
   result.drift_vector_m = p_est_last - ref.back().pose.translation();
   result.drift_m = result.drift_vector_m.norm();
+  // Heading only: the turn about z between the first poses' headings (their x axes projected
+  // on the horizontal), whatever their roll and pitch.
+  const auto headingRad = [](const StampedPose& p) {
+    const Eigen::Matrix3d R = p.pose.rotation().matrix();
+    return std::atan2(R(1, 0), R(0, 0));
+  };
+  const Eigen::Matrix3d R_heading =
+      Eigen::AngleAxisd(headingRad(ref.front()) - headingRad(est.front()),
+                        Eigen::Vector3d::UnitZ())
+          .toRotationMatrix();
+  result.heading_aligned_drift_vector_m =
+      R_heading * (est.back().pose.translation() - est.front().pose.translation()) -
+      (ref.back().pose.translation() - ref.front().pose.translation());
   for (std::size_t i = 1; i < ref.size(); ++i)
     result.reference_path_length_m +=
         (ref[i].pose.translation() - ref[i - 1].pose.translation()).norm();

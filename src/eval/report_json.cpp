@@ -99,7 +99,9 @@ std::string formatEvalJson(const EvalReport& report) {
   j["drift"] = {{"drift_m", r.drift.drift_m},
                 {"drift_vector_m", detail::vectorJson(r.drift.drift_vector_m)},
                 {"reference_path_length_m", r.drift.reference_path_length_m},
-                {"drift_percent", r.drift.drift_percent}};
+                {"drift_percent", r.drift.drift_percent},
+                {"heading_aligned_drift_vector_m",
+                 detail::vectorJson(r.drift.heading_aligned_drift_vector_m)}};
   const DistanceDistribution& d = r.distance;
   j["distance"] = {{"mean_m", d.mean_m},
                    {"std_m", d.std_m},

@@ -70,6 +70,11 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
   rows.push_back({"End-point drift (% of path)",
                   fmt::format("{:.4f} (reference path {:.3f} m)", r.drift.drift_percent,
                               r.drift.reference_path_length_m)});
+  const Eigen::Vector3d& heading = r.drift.heading_aligned_drift_vector_m;
+  rows.push_back({"End-point drift, heading aligned (m)",
+                  fmt::format("dx {:.6f}, dy {:.6f}, dz {:.6f}; first poses aligned in position "
+                              "and heading, not in roll and pitch",
+                              heading.x(), heading.y(), heading.z())});
   if (report.show_distance) {
     const DistanceDistribution& d = r.distance;
     rows.push_back({"Distance est-ref, unaligned (m)",

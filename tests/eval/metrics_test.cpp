@@ -174,6 +174,26 @@ TEST(Drift, EndPointErrorAfterAligningTheFirstPose) {
   EXPECT_NEAR(d.drift_percent, 5.0, 1e-9);
 }
 
+TEST(Drift, HeadingAlignedDriftIgnoresTheFirstPosesTiltButNotAWorldTilt) {
+  // 100 m along x, exact, in a frame turned by 30 deg about z and shifted; only the first pose's
+  // attitude is 1 deg off in pitch. Aligned on that pose, the end point is 1.75 m off in z; with
+  // position and heading only it is exact.
+  const std::vector<StampedPose> ref = test::straightLine(101, 1.0);
+  const lie::SE3 T(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.5), {10.0, -5.0, 2.0});
+  std::vector<StampedPose> est = test::transformed(T, ref);
+  est.front().pose = lie::SE3(est.front().pose.rotation() *
+                                  lie::SO3::fromRollPitchYaw(0.0, 1.0 * kRadPerDeg, 0.0),
+                              est.front().pose.translation());
+  const DriftResult d = computeDrift(est, ref);
+  EXPECT_NEAR(std::abs(d.drift_vector_m.z()), 100.0 * std::sin(1.0 * kRadPerDeg), 1e-6);
+  EXPECT_LT(d.heading_aligned_drift_vector_m.norm(), 1e-9);
+  // A world tilted by 1 deg about y (the whole estimate, first pose included) stays visible.
+  const std::vector<StampedPose> tilted =
+      test::transformed(lie::SE3(lie::SO3::fromRollPitchYaw(0.0, 1.0 * kRadPerDeg, 0.0), {}), ref);
+  EXPECT_NEAR(std::abs(computeDrift(tilted, ref).heading_aligned_drift_vector_m.z()),
+              100.0 * std::sin(1.0 * kRadPerDeg), 1e-6);
+}
+
 TEST(Distance, HistogramInTenthsOfAMetreAndItsSpread) {
   const std::vector<double> distances{0.05, 0.15, 0.16, 0.25, 0.27, 0.28};
   std::vector<StampedPose> a, b;
