@@ -67,8 +67,7 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
         preprocess::voxelFilter(second_in_body, config_.voxel_size_m,
                                 preprocess::voxelRepresentative(config_.voxel_point))
             .positions,
-        target_in_odom,
-        poseOf(over_second.back().state), ndt);
+        target_in_odom, poseOf(over_second.back().state), ndt);
     if (r.num_inliers == 0 || !std::isfinite(r.hessian_condition)) {
       logger().warn(
           "initial velocity: the second scan did not register to the first ({}); starting from "

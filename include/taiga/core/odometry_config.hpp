@@ -74,8 +74,8 @@ struct OdometryConfig final : ConfigSection {
   double max_range_m = 80.0;
   double voxel_size_m = 0.4;  ///< voxel filter of the registration source
   /// Which point stands for each of its voxels: centroid, or measured (the return nearest the
-  /// voxel's mean: less shrink, but a lidar-only re-attachment failed with it; docs/registration.md,
-  /// "Bias").
+  /// voxel's mean: less shrink, but a lidar-only re-attachment failed with it;
+  /// docs/registration.md, "Bias").
   std::string voxel_point = "centroid";
   // Registration to the local map.
   /// auto | lidar_inertial | lidar_only. auto: lidar-only when the recording has delivered no

@@ -15,11 +15,12 @@ namespace taiga::eval {
 ///   drift_vector = p_est,last - p_ref,last after the origin alignment,
 ///   drift_percent = |drift_vector| / reference path length x 100,
 /// with the path length summed over the associated reference positions.
-/// The same with the first pose aligned in position and heading only (the turn about the
-/// vertical between the first poses' headings, their x axes projected on the horizontal), for estimates whose z axis is gravity's, as taiga's:
-/// an error in the first pose's roll and pitch then does not turn into a drift growing with
-/// the distance from the start (0.5 deg: 0.9 m at 100 m), while a tilted world frame still
-/// does. `heading_aligned_drift_vector_m` is that end-point error.
+/// `heading_aligned_drift_vector_m`: the same end-point error with the first pose aligned in
+/// position and heading only (the turn about the vertical between the first poses' headings,
+/// their x axes projected on the horizontal), for estimates whose z axis is gravity's, as
+/// taiga's: an error in the first pose's roll and pitch then does not turn into a drift growing
+/// with the distance from the start (0.5 deg: 0.9 m at 100 m), while a tilted world frame still
+/// does.
 struct DriftResult {
   Eigen::Vector3d drift_vector_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d heading_aligned_drift_vector_m = Eigen::Vector3d::Zero();
