@@ -26,6 +26,7 @@ struct SimulateOptions {
   std::optional<int> beams;            // command-line values win over the scenario and the file
   std::optional<int> columns;
   std::optional<int> sub_rays;
+  std::optional<std::string> pcap_profile;  // also capture.pcap + capture.json
   bool reference_cloud = false;        // also write reference_cloud.las (a TLS survey)
   sim::ReferenceCloudParams reference;
 };
@@ -38,6 +39,7 @@ int runSimulate(const SimulateOptions& options) {
   if (options.beams) scenario.lidar.beams = *options.beams;
   if (options.columns) scenario.lidar.columns = *options.columns;
   if (options.sub_rays) scenario.lidar.sub_rays = *options.sub_rays;
+  if (options.pcap_profile) scenario.output.pcap_profile = *options.pcap_profile;
   const double duration_s = options.duration_s.value_or(scenario.duration_s);
   const auto start = std::chrono::steady_clock::now();
   const sim::Simulation simulation(scenario, duration_s, options.seed);
@@ -121,6 +123,13 @@ Command addSimulateCommand(CLI::App& tool) {
                    "Rays per beam at depth edges for the beam divergence (1: none, about 2x "
                    "faster; default 4)")
       ->check(CLI::Range(1, 8));
+  parser
+      ->add_option("--pcap", options->pcap_profile,
+                   "Also write capture.pcap + capture.json: the scans and IMU samples as an Ouster "
+                   "sensor's UDP packets with its metadata, in this lidar profile")
+      ->expected(0, 1)
+      ->default_str("RNG19_RFL8_SIG16_NIR16")
+      ->check(CLI::IsMember({"LEGACY", "RNG19_RFL8_SIG16_NIR16", "RNG15_RFL8_NIR8"}));
   parser->add_flag("--reference-cloud", options->reference_cloud,
                    "Also write reference_cloud.las: a dense, noise-free cloud of the plot as a "
                    "terrestrial scanner records it from stations along the true path");

@@ -281,6 +281,10 @@ class OutputSection final : public TableSection<OutputParams> {
     static constexpr std::string_view kLayouts[] = {"ouster", "velodyne", "deskewed"};
     v.choice("point_layout", params_.point_layout, kLayouts,
              "ouster (organized, t), velodyne (flat, ring, time), deskewed (flat, no time)");
+    static constexpr std::string_view kProfiles[] = {"", "LEGACY", "RNG19_RFL8_SIG16_NIR16",
+                                                     "RNG15_RFL8_NIR8"};
+    v.choice("pcap_profile", params_.pcap_profile, kProfiles,
+             "also capture.pcap + capture.json in this Ouster lidar profile; empty: none");
   }
 };
 

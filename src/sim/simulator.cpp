@@ -11,6 +11,7 @@
 #include "taiga/io/rosbag.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/sim/random.hpp"
+#include "ouster_capture_output.hpp"
 #include "truth_outputs.hpp"
 
 namespace taiga::sim {
@@ -159,6 +160,11 @@ SimulationSummary writeSimulation(const Simulation& simulation,
   io::BagWriter bag(out_dir / "recording.bag");
   ImuSimulator imu(scenario.imu, simulation.seed(), scenario.gnss.world_yaw_deg);
   GnssSimulator gnss(scenario.gnss, simulation.seed());
+  std::optional<detail::OusterCaptureWriter> capture;
+  if (!scenario.output.pcap_profile.empty())
+    capture.emplace(out_dir, detail::simulatedSensorInfo(scenario.lidar, lidar.geometry(),
+                                                         scenario.output.pcap_profile,
+                                                         simulation.seed()));
   Trajectory ground_truth;
   auto emitUntil = [&](double t_end_s) {
     while (imu.nextTime_s() <= t_end_s) {
@@ -168,6 +174,7 @@ SimulationSummary writeSimulation(const Simulation& simulation,
       const bool gap = t >= f.imu_gap_start_s && t < f.imu_gap_start_s + f.imu_gap_s;
       if (scenario.output.imu && !gap) {
         bag.writeImu(kImuTopic, "os_imu", sample);
+        if (capture) capture->writeImu(sample, t + kRecordingEpoch_s);
         ++summary.imu_samples;
       }
       // The truth at the IMU's instants (not its jittered stamps).
@@ -207,6 +214,9 @@ SimulationSummary writeSimulation(const Simulation& simulation,
       if (on_scan) on_scan(k + 1, scans);
       continue;
     }
+    if (capture)  // the raw scan, before a deskewed layout moves its points
+      capture->writeScan(scan, static_cast<std::uint16_t>(k),
+                         kRecordingEpoch_s - lidar_clock_s);
     if (output.point_layout == "velodyne") {
       bag.writeScanAs(io::ScanLayout::kVelodyne, kLidarTopic, "velodyne", scan);
     } else if (output.point_layout == "deskewed") {
@@ -225,6 +235,7 @@ SimulationSummary writeSimulation(const Simulation& simulation,
   }
   emitUntil(simulation.duration_s());
   bag.close();
+  if (capture) capture->close();
   if (summary.scans == 0) summary.min_points_per_scan = 0;
   summary.path_length_m = ground_truth.size() > 1 ? ground_truth.pathLength() : 0.0;
 

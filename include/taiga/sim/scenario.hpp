@@ -202,6 +202,10 @@ struct OutputParams {
   int scan_stride = 1;  ///< keep every n-th scan (5: a 2 Hz keyframe sequence from a 10 Hz lidar)
   bool imu = true;      ///< write the IMU topic
   bool gnss = true;     ///< write the GNSS topic
+  /// Also write capture.pcap + capture.json, the scans and IMU samples as an Ouster sensor's UDP
+  /// packets in this lidar profile (LEGACY, RNG19_RFL8_SIG16_NIR16, RNG15_RFL8_NIR8); empty: no
+  /// capture.
+  std::string pcap_profile;
 };
 
 /// Faults injected into the recording, to test that a run says what went wrong (the
