@@ -5,12 +5,14 @@
 #endif
 
 #include <cmath>
+#include <csignal>
 #include <memory>
 
 #include "command.hpp"
 #include "recording_options.hpp"
 #include "taiga/core/angles.hpp"
 #include "taiga/core/config.hpp"
+#include "taiga/core/errors.hpp"
 #include "taiga/pipeline/run.hpp"
 
 namespace taiga::app {
@@ -18,6 +20,7 @@ namespace {
 struct RunOptions {
   std::string recording, config, out;
   bool realtime = false;
+  bool live = false;
   bool ply = false;
   double map_voxel_m = 0.0;
   std::string registration;
@@ -91,17 +94,46 @@ void printCalibration(const pipeline::CalibrationRunReport& c) {
   if (!c.gyro_noise_text.empty()) fmt::print("           {}\n", c.gyro_noise_text);
 }
 
+// Ctrl-C and SIGTERM end a live run cleanly: the packet streams end, the run finishes and writes
+// every output. A second signal kills the process as usual.
+void stopLiveOnSignal(int signal) {
+  io::ouster::requestLiveStop();
+  std::signal(signal, SIG_DFL);
+}
+
+void printLive(const io::ouster::LiveStats& l, const pipeline::RealtimeReport& r) {
+  fmt::print(
+      "live       {} lidar and {} IMU packets; {} frames, {} incomplete ({} columns missing: lost "
+      "packets), {} bad packets, {} other datagrams, {} dropped by the kernel; ended: {}\n",
+      l.lidar_packets, l.imu_packets, l.frames, l.incomplete_frames, l.missing_columns,
+      l.bad_packets, l.other_datagrams, l.kernel_drops, l.stop_reason);
+  fmt::print(
+      "           {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, {:.1f} "
+      "ms max from a scan's last packet to its pose\n",
+      r.dropped_scans, r.latency_p50_ms, r.latency_p95_ms, r.latency_max_ms);
+}
+
 int run(const RunOptions& options) {
   useOneMallocArena();
   SystemConfig config = loadConfig(options.config);
   if (!options.registration.empty()) config.odometry.method = options.registration;
   validateAll(config);
-  const pipeline::RunSummary s = pipeline::runOdometry(options.recording, config,
-                                                       {.out_dir = options.out,
-                                                        .write_ply = options.ply,
-                                                        .map_voxel_m = options.map_voxel_m,
-                                                        .realtime = options.realtime,
-                                                        .moving_boxes_file = options.moving_boxes});
+  if (options.live == !options.recording.empty())
+    throw InputError("taiga run: give either a RECORDING or --live, not both or neither");
+  if (options.live && options.realtime)
+    throw InputError("taiga run: --realtime replays a recording at sensor rate; --live is live");
+  const pipeline::RunOptions run_options{.out_dir = options.out,
+                                         .write_ply = options.ply,
+                                         .map_voxel_m = options.map_voxel_m,
+                                         .realtime = options.realtime,
+                                         .moving_boxes_file = options.moving_boxes};
+  if (options.live) {
+    std::signal(SIGINT, stopLiveOnSignal);
+    std::signal(SIGTERM, stopLiveOnSignal);
+  }
+  const pipeline::RunSummary s = options.live
+                                     ? pipeline::runLive(config, run_options)
+                                     : pipeline::runOdometry(options.recording, config, run_options);
   if (s.calibration) printCalibration(*s.calibration);
   fmt::print("scans      {} read, {} processed; {} IMU samples; {:.1f} s, {:.1f} m of path\n",
              s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
@@ -109,9 +141,10 @@ int run(const RunOptions& options) {
              s.lidar_rejected, s.lidar_inflated, s.keyframes, s.map_points);
   printHealth(s.health);
   fmt::print(
-      "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {:.2f}x real time; peak "
-      "memory {:.0f} MB\n",
-      s.mean_ms, s.p95_ms, s.max_ms, s.realtime_factor, s.peak_memory_mb);
+      "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {}; peak memory {:.0f} "
+      "MB\n",
+      s.mean_ms, s.p95_ms, s.max_ms,
+      s.live ? "live" : fmt::format("{:.2f}x real time", s.realtime_factor), s.peak_memory_mb);
   fmt::print("mapping    {} loop closures (loops.csv); map exported in {:.1f} s after the run\n",
              s.loop_closures, s.map_export_s);
   if (s.trees)
@@ -119,7 +152,9 @@ int run(const RunOptions& options) {
         "trees      {} stems in trees.csv (the live list's worker busy {:.1f} s during the "
         "run; the final inventory {:.1f} s after it)\n",
         *s.trees, s.trees_work_s, s.trees_final_s);
-  if (s.realtime) {
+  if (s.live) {
+    printLive(*s.live, *s.realtime);
+  } else if (s.realtime) {
     fmt::print(
         "realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "
         "{:.1f} ms max from delivery to pose\n",
@@ -151,13 +186,15 @@ Command addRunCommand(CLI::App& tool) {
   auto options = std::make_shared<RunOptions>();
   CLI::App* parser = tool.add_subcommand(
       "run", "Estimate the trajectory and build the forest map from a recording");
-  parser->add_option("RECORDING", options->recording, "ROS1 bag, Ouster pcap or folder")
-      ->required();
+  parser->add_option("RECORDING", options->recording, "ROS1 bag, Ouster pcap or folder");
   addConfigOption(*parser, options->config);
   parser->add_option("--out", options->out, "Output directory")->required();
   parser->add_flag("--realtime", options->realtime,
                    "Replay at sensor rate as a live sensor would deliver it: scans are dropped "
                    "when more than 2 wait, and dropped scans and latency are reported");
+  parser->add_flag("--live", options->live,
+                   "Run on a live Ouster sensor's UDP packets (configuration section live:) "
+                   "instead of a recording, until Ctrl-C or live.idle_timeout_s without a packet");
   parser->add_flag("--ply", options->ply, "Also write map.ply");
   parser
       ->add_option("--registration", options->registration,

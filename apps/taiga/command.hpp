@@ -43,6 +43,7 @@ Command addGeorefCommand(CLI::App& tool);
 Command addConfigCommand(CLI::App& tool);
 Command addExportMapCommand(CLI::App& tool);
 Command addCalibrateCommand(CLI::App& tool);
+Command addReplayCommand(CLI::App& tool);
 Command addTreesCommand(CLI::App& tool);
 
 }  // namespace taiga::app

@@ -34,7 +34,8 @@ int runTool(int argc, char** argv) {
       addSimulateCommand(tool),  addInfoCommand(tool),      addExportCommand(tool),
       addRegisterCommand(tool),  addRunCommand(tool),       addEvalCommand(tool),
       addCompareCommand(tool),   addGeorefCommand(tool),    addConfigCommand(tool),
-      addExportMapCommand(tool), addCalibrateCommand(tool), addTreesCommand(tool)};
+      addExportMapCommand(tool), addCalibrateCommand(tool), addTreesCommand(tool),
+      addReplayCommand(tool)};
 
   try {
     tool.parse(argc, argv);

@@ -53,8 +53,10 @@ void RecordingFeed::read(io::Recording& recording) {
       const double t_event = io::eventTime(*event);
       if (!first_event_s) first_event_s = t_event;
       const Clock::time_point due =
-          wall_start + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double>(t_event - *first_event_s));
+          pacing_ == Pacing::kLive
+              ? Clock::now()
+              : wall_start + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(t_event - *first_event_s));
       {
         std::unique_lock lock(mutex_);
         if (!waitForRoom(lock, *event, due)) return;

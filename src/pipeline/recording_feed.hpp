@@ -9,6 +9,8 @@
 //   them; when the odometry falls behind by more than `max_queued_scans` scans, the oldest
 //   waiting scan is dropped. IMU readings never are (they are small, and the preintegration
 //   needs every one).
+// - kLive (taiga run --live): the recording is a live sensor that delivers at its own pace;
+//   events are handed over as they come, with kSensorRate's dropping.
 // Internal to the pipeline module.
 
 #include <chrono>
@@ -26,7 +28,7 @@ namespace taiga::pipeline {
 class RecordingFeed {
  public:
   using Clock = std::chrono::steady_clock;
-  enum class Pacing { kAsFastAsPossible, kSensorRate };
+  enum class Pacing { kAsFastAsPossible, kSensorRate, kLive };
   struct Delivery {
     io::RecordingEvent event;
     Clock::time_point delivered;  ///< when the event entered the queue
@@ -41,7 +43,7 @@ class RecordingFeed {
 
   /// The next event, waiting for it; nothing at the end. Rethrows what the reader threw.
   std::optional<Delivery> next();
-  /// Scans dropped because the queue was full (kSensorRate only).
+  /// Scans dropped because the queue was full (kSensorRate and kLive).
   std::size_t droppedScans() const;
 
  private:

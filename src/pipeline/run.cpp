@@ -21,6 +21,7 @@
 #include "taiga/core/percentile.hpp"
 #include "taiga/core/progress.hpp"
 #include "taiga/io/moving_boxes.hpp"
+#include "taiga/io/ouster/live.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/mapping/map_export.hpp"
 #include "taiga/pipeline/self_calibration.hpp"
@@ -90,8 +91,9 @@ bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
 /// that reads and decodes ahead (at most a few scans), at sensor rate under --realtime.
 /// Returns the scans read and, under --realtime, what a live run would have seen.
 std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEvent> read_ahead,
-                          const RunOptions& options, SlamSystem& slam, ScanLog& scan_log,
-                          const HealthLog& health, std::optional<RealtimeReport>& realtime) {
+                          const RunOptions& options, const LiveConfig* live, SlamSystem& slam,
+                          ScanLog& scan_log, const HealthLog& health,
+                          std::optional<RealtimeReport>& realtime) {
   Progress progress("taiga run", 0, "scans", stderr,
                     options.show_progress && isatty(fileno(stderr)));
   std::size_t scans = 0;
@@ -105,17 +107,20 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
   };
   for (const io::RecordingEvent& event : read_ahead) handle(event);
   constexpr std::size_t kReadAheadScans = 3;
-  RecordingFeed feed(recording,
-                     options.realtime ? RecordingFeed::Pacing::kSensorRate
-                                      : RecordingFeed::Pacing::kAsFastAsPossible,
-                     options.realtime ? options.realtime_queue_scans : kReadAheadScans);
+  const auto pacing = live != nullptr    ? RecordingFeed::Pacing::kLive
+                      : options.realtime ? RecordingFeed::Pacing::kSensorRate
+                                         : RecordingFeed::Pacing::kAsFastAsPossible;
+  RecordingFeed feed(recording, pacing,
+                     live != nullptr    ? static_cast<std::size_t>(live->max_queued_scans)
+                     : options.realtime ? options.realtime_queue_scans
+                                        : kReadAheadScans);
   std::vector<double> latencies_ms;
   while (std::optional<RecordingFeed::Delivery> delivery = feed.next()) {
     read_ms_since_scan += delivery->read_ms;
     if (handle(delivery->event)) latencies_ms.push_back(1000.0 * secondsSince(delivery->delivered));
   }
   progress.finish();
-  if (options.realtime)
+  if (pacing != RecordingFeed::Pacing::kAsFastAsPossible)
     realtime = RealtimeReport{.dropped_scans = feed.droppedScans(),
                               .latency_p50_ms = percentile(latencies_ms, 50.0),
                               .latency_p95_ms = percentile(latencies_ms, 95.0),
@@ -182,24 +187,17 @@ std::uint64_t exportMaps(const mapping::KeyframeStore& store, const mapping::Map
   return mapping::exportMap(store, graph.poses(), out / "map.las", attached_options).points_written;
 }
 
-}  // namespace
+bool calibratesAtStart(const SystemConfig& config) {
+  return config.calibration.at_start && config.odometry.imu_use != "lidar_only";
+}
 
-RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& configured,
-                       const RunOptions& options) {
+/// The SLAM system over `recording` (from `recording_path`, or a live sensor's streams when
+/// `live` is given), its outputs written into options.out_dir.
+RunSummary runRecording(io::Recording& recording, const std::filesystem::path& recording_path,
+                        const SystemConfig& config,
+                        std::optional<CalibrationRunReport> calibration, const RunOptions& options,
+                        const io::ouster::LiveCapture* live) {
   const std::filesystem::path& out = options.out_dir;
-  createOutputDirectory(out);
-  SystemConfig config = configured;
-  std::optional<CalibrationRunReport> calibration;
-  if (config.calibration.at_start && config.odometry.imu_use != "lidar_only") {
-    if (options.realtime)  // a live sensor gives no stretch to read ahead
-      calibration = CalibrationRunReport{
-          .skipped =
-              "not under --realtime, which replays the recording as a live sensor would "
-              "deliver it; calibrate with taiga calibrate first"};
-    else
-      calibration = calibrateAtStart(recording_path, config);
-  }
-  io::Recording recording = io::openRecording(recording_path, config.recording, config.rig);
   std::deque<io::RecordingEvent> read_ahead;
   SlamSystem slam(config,
                   {.keyframe_dir = out / "keyframes",
@@ -219,8 +217,10 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
 
   RunSummary summary;
   const auto wall_start = Clock::now();
-  summary.scans = feedRecording(recording, std::move(read_ahead), options, slam, scan_log, health,
+  summary.scans = feedRecording(recording, std::move(read_ahead), options,
+                                live != nullptr ? &config.live : nullptr, slam, scan_log, health,
                                 summary.realtime);
+  if (live != nullptr) summary.live = live->stats();
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);
@@ -269,6 +269,48 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   summary.calibration = calibration;
   writeSummary(out / "summary.json", summary, recording_path, mapper.gnssReport());
   return summary;
+}
+
+}  // namespace
+
+RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& configured,
+                       const RunOptions& options) {
+  createOutputDirectory(options.out_dir);
+  SystemConfig config = configured;
+  std::optional<CalibrationRunReport> calibration;
+  if (calibratesAtStart(config)) {
+    if (options.realtime)  // a live sensor gives no stretch to read ahead
+      calibration = CalibrationRunReport{
+          .skipped =
+              "not under --realtime, which replays the recording as a live sensor would "
+              "deliver it; calibrate with taiga calibrate first"};
+    else
+      calibration = calibrateAtStart(recording_path, config);
+  }
+  io::Recording recording = io::openRecording(recording_path, config.recording, config.rig);
+  return runRecording(recording, recording_path, config, calibration, options, nullptr);
+}
+
+RunSummary runLive(const SystemConfig& config, const RunOptions& options) {
+  if (config.live.metadata.empty())
+    throw InputError(
+        "live.metadata: a live run needs the sensor's metadata JSON (beam angles, packet "
+        "profiles, ports); set it in the configuration");
+  createOutputDirectory(options.out_dir);
+  io::ouster::LiveCapture capture(
+      {.metadata = config.live.metadata,
+       .bind_address = config.live.bind_address,
+       .lidar_port = static_cast<std::uint16_t>(config.live.lidar_port),
+       .imu_port = static_cast<std::uint16_t>(config.live.imu_port),
+       .idle_timeout_s = config.live.idle_timeout_s,
+       .socket_buffer_bytes = static_cast<int>(config.live.socket_buffer_mb * 1e6)});
+  std::optional<CalibrationRunReport> calibration;
+  if (calibratesAtStart(config))  // a live sensor gives no stretch to read ahead
+    calibration = CalibrationRunReport{
+        .skipped = "not on a live sensor: calibrate a recording of the rig with taiga calibrate "
+                   "and give the run its rig.yaml"};
+  io::Recording recording = capture.recording(config.rig.lidar_time_offset_s);
+  return runRecording(recording, capture.name(), config, calibration, options, &capture);
 }
 
 }  // namespace taiga::pipeline

@@ -144,6 +144,15 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
                        {"p95", s.realtime->latency_p95_ms},
                        {"max", s.realtime->latency_max_ms}}}};
   }
+  if (s.live) {
+    const io::ouster::LiveStats& l = *s.live;
+    j["live"] = {{"lidar_packets", l.lidar_packets},   {"imu_packets", l.imu_packets},
+                 {"other_datagrams", l.other_datagrams}, {"kernel_drops", l.kernel_drops},
+                 {"bad_packets", l.bad_packets},       {"frames", l.frames},
+                 {"incomplete_frames", l.incomplete_frames},
+                 {"missing_columns", l.missing_columns}, {"max_backlog", l.max_backlog},
+                 {"stop_reason", l.stop_reason}};
+  }
   if (s.georef) {
     const GeorefRunReport& g = *s.georef;
     nlohmann::ordered_json georef = {{"fixes", g.fixes}};

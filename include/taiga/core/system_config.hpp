@@ -5,6 +5,7 @@
 #include "taiga/core/config.hpp"
 #include "taiga/core/calibration_config.hpp"
 #include "taiga/core/georef_config.hpp"
+#include "taiga/core/live_config.hpp"
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/core/recording_config.hpp"
@@ -19,6 +20,7 @@ struct SystemConfig final : ConfigSection {
   MappingConfig mapping;
   GeorefConfig georef;
   CalibrationConfig calibration;
+  LiveConfig live;
 
   void visit(ConfigVisitor& v) override {
     v.section("rig", rig, "sensor rig: extrinsics, clock offset and units");
@@ -29,6 +31,7 @@ struct SystemConfig final : ConfigSection {
     v.section("georef", georef, "georeferencing with GNSS: post-fit method, output CRS, gating");
     v.section("calibration", calibration,
               "self-calibration of the lidar-IMU time offset and extrinsic rotation");
+    v.section("live", live, "taiga run --live: the sensor's UDP packets, and what a live run does");
   }
 };
 

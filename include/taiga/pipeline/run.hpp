@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "taiga/core/system_config.hpp"
+#include "taiga/io/ouster/live.hpp"
 
 namespace taiga::pipeline {
 
@@ -158,6 +159,7 @@ struct RunSummary {
   std::optional<RealtimeReport> realtime;           ///< with --realtime only
   std::optional<GeorefRunReport> georef;            ///< when the recording has GNSS fixes
   std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
+  std::optional<io::ouster::LiveStats> live;        ///< taiga run --live: the packets' fate
   /// With mapping.trees: the stems in trees.csv, the worker's busy time on the live list during
   /// the run and the final inventory's time after it, s.
   std::optional<std::size_t> trees;
@@ -169,5 +171,10 @@ struct RunSummary {
 /// Throws InputError for unreadable input or an unwritable output directory.
 RunSummary runOdometry(const std::filesystem::path& recording, const SystemConfig& config,
                        const RunOptions& options);
+
+/// The same on a live Ouster sensor's UDP packets (config.live, io/ouster/live.hpp), until
+/// io::ouster::requestLiveStop() or live.idle_timeout_s without a packet; scans are dropped when
+/// more than live.max_queued_scans wait (RunSummary::realtime says how many, and the latency).
+RunSummary runLive(const SystemConfig& config, const RunOptions& options);
 
 }  // namespace taiga::pipeline

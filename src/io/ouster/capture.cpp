@@ -175,14 +175,17 @@ OusterCapture openOusterCaptureStreams(const std::filesystem::path& pcap,
   if (p.lidar_port) {
     std::optional<std::size_t> ignore;
     if (shared) ignore = ImuPacketLayout::of(capture.info).packet_bytes;
-    capture.lidar = std::make_unique<OusterLidarSource>(pcap, capture.info, *p.lidar_port,
-                                                        options.decoder, ignore);
+    capture.lidar = std::make_unique<OusterLidarSource>(
+        fmt::format("{} (lidar)", pcap.string()),
+        std::make_unique<PcapPortSource>(pcap, *p.lidar_port, ignore), capture.info,
+        options.decoder);
   }
   if (p.imu_port) {
     std::optional<std::size_t> ignore;
     if (shared) ignore = LidarPacketLayout::of(capture.info).packet_bytes;
-    capture.imu =
-        std::make_unique<OusterImuSource>(pcap, capture.info, *p.imu_port, options.decoder, ignore);
+    capture.imu = std::make_unique<OusterImuSource>(
+        fmt::format("{} (IMU)", pcap.string()),
+        std::make_unique<PcapPortSource>(pcap, *p.imu_port, ignore), capture.info, options.decoder);
   }
   return capture;
 }

@@ -7,14 +7,22 @@
 
 namespace taiga::io::ouster {
 
-OusterLidarSource::OusterLidarSource(const std::filesystem::path& pcap, const SensorInfo& info,
-                                     std::uint16_t port, const DecoderOptions& options,
-                                     std::optional<std::size_t> ignore_size)
-    : name_(fmt::format("{} (lidar)", pcap.string())),
-      reader_(pcap),
-      assembler_(info, options, name_),
-      port_(port),
-      ignore_size_(ignore_size) {}
+PcapPortSource::PcapPortSource(const std::filesystem::path& pcap, std::uint16_t port,
+                               std::optional<std::size_t> ignore_size)
+    : reader_(pcap), port_(port), ignore_size_(ignore_size) {}
+
+std::optional<std::span<const std::uint8_t>> PcapPortSource::next() {
+  while (const std::optional<UdpDatagram> datagram = reader_.next()) {
+    if (datagram->destination_port != port_) continue;
+    if (ignore_size_ && datagram->payload.size() == *ignore_size_) continue;
+    return datagram->payload;
+  }
+  return std::nullopt;
+}
+
+OusterLidarSource::OusterLidarSource(std::string name, std::unique_ptr<DatagramSource> datagrams,
+                                     const SensorInfo& info, const DecoderOptions& options)
+    : name_(std::move(name)), datagrams_(std::move(datagrams)), assembler_(info, options, name_) {}
 
 std::optional<AssembledFrame> OusterLidarSource::nextFrame() {
   while (true) {
@@ -35,17 +43,15 @@ std::optional<AssembledFrame> OusterLidarSource::nextFrame() {
       return frame;
     }
     if (finished_) return std::nullopt;
-    const std::optional<UdpDatagram> datagram = reader_.next();
-    if (!datagram) {
+    const std::optional<std::span<const std::uint8_t>> payload = datagrams_->next();
+    if (!payload) {
       finished_ = true;
       assembler_.finish();
       if (out_of_order_ > 1)
         logger().warn("{}: dropped {} frames whose time went back", name_, out_of_order_);
       continue;
     }
-    if (datagram->destination_port != port_) continue;
-    if (ignore_size_ && datagram->payload.size() == *ignore_size_) continue;
-    assembler_.addPacket(datagram->payload);
+    assembler_.addPacket(*payload);
   }
 }
 
@@ -55,14 +61,9 @@ std::optional<RecordingEvent> OusterLidarSource::next() {
   return RecordingEvent(std::move(frame->scan));
 }
 
-OusterImuSource::OusterImuSource(const std::filesystem::path& pcap, const SensorInfo& info,
-                                 std::uint16_t port, const DecoderOptions& options,
-                                 std::optional<std::size_t> ignore_size)
-    : name_(fmt::format("{} (IMU)", pcap.string())),
-      reader_(pcap),
-      decoder_(info, options),
-      port_(port),
-      ignore_size_(ignore_size) {}
+OusterImuSource::OusterImuSource(std::string name, std::unique_ptr<DatagramSource> datagrams,
+                                 const SensorInfo& info, const DecoderOptions& options)
+    : name_(std::move(name)), datagrams_(std::move(datagrams)), decoder_(info, options) {}
 
 OusterImuSource::~OusterImuSource() { reportDrops(); }
 
@@ -86,17 +87,15 @@ std::optional<RecordingEvent> OusterImuSource::next() {
       last_t_s_ = sample.t_s;
       return RecordingEvent(sample);
     }
-    const std::optional<UdpDatagram> datagram = reader_.next();
-    if (!datagram) {
+    const std::optional<std::span<const std::uint8_t>> payload = datagrams_->next();
+    if (!payload) {
       reportDrops();
       return std::nullopt;
     }
-    if (datagram->destination_port != port_) continue;
-    if (ignore_size_ && datagram->payload.size() == *ignore_size_) continue;
     ++packets_;
     int skipped = 0;
     next_sample_ = 0;
-    const PacketStatus status = decoder_.decode(datagram->payload, packet_samples_, &skipped);
+    const PacketStatus status = decoder_.decode(*payload, packet_samples_, &skipped);
     dropped_samples_ += static_cast<std::uint64_t>(skipped);
     if (status != PacketStatus::kOk) {
       ++dropped_packets_;
@@ -105,7 +104,7 @@ std::optional<RecordingEvent> OusterImuSource::next() {
         logger().warn(
             "{}: dropped a {}-byte IMU packet: {} (expected {} bytes for {}; further "
             "drops are counted and reported at the end)",
-            name_, datagram->payload.size(), describe(status), decoder_.layout().packet_bytes,
+            name_, payload->size(), describe(status), decoder_.layout().packet_bytes,
             profileName(decoder_.layout().profile));
       }
     }

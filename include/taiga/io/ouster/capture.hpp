@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,12 +41,35 @@ struct CaptureProbe {
   std::uint64_t imu_packets = 0;            ///< of the IMU packet size on imu_port
 };
 
-/// Scans of one capture, in the Ouster sensor frame (see frame_assembler.hpp).
+/// The payloads of one sensor stream's UDP datagrams: from a capture file (PcapPortSource) or
+/// from a socket (live.hpp).
+class DatagramSource {
+ public:
+  virtual ~DatagramSource() = default;
+  /// The next payload, valid until the next call; nothing at the end of the stream.
+  virtual std::optional<std::span<const std::uint8_t>> next() = 0;
+};
+
+/// The datagrams sent to `port` in a capture file, but those of `ignore_size` bytes (when a
+/// port carries both streams).
+class PcapPortSource final : public DatagramSource {
+ public:
+  PcapPortSource(const std::filesystem::path& pcap, std::uint16_t port,
+                 std::optional<std::size_t> ignore_size = std::nullopt);
+  std::optional<std::span<const std::uint8_t>> next() override;
+
+ private:
+  PcapReader reader_;
+  std::uint16_t port_;
+  std::optional<std::size_t> ignore_size_;
+};
+
+/// Scans of one lidar packet stream, in the Ouster sensor frame (see frame_assembler.hpp).
 class OusterLidarSource final : public StreamSource {
  public:
-  OusterLidarSource(const std::filesystem::path& pcap, const SensorInfo& info, std::uint16_t port,
-                    const DecoderOptions& options = {},
-                    std::optional<std::size_t> ignore_size = std::nullopt);
+  /// `name` names the stream in messages, e.g. "drive.pcap (lidar)".
+  OusterLidarSource(std::string name, std::unique_ptr<DatagramSource> datagrams,
+                    const SensorInfo& info, const DecoderOptions& options = {});
   std::string name() const override { return name_; }
   std::optional<RecordingEvent> next() override;
   /// Like next(), with the frame id and column counts.
@@ -54,22 +78,19 @@ class OusterLidarSource final : public StreamSource {
 
  private:
   std::string name_;
-  PcapReader reader_;
+  std::unique_ptr<DatagramSource> datagrams_;
   FrameAssembler assembler_;
-  std::uint16_t port_;
-  std::optional<std::size_t> ignore_size_;
   bool finished_ = false;
   std::uint64_t delivered_ = 0;
   std::optional<double> last_t_end_s_;
   std::uint64_t out_of_order_ = 0;
 };
 
-/// IMU samples of one capture, in the IMU frame (see imu_packet.hpp).
+/// IMU samples of one IMU packet stream, in the IMU frame (see imu_packet.hpp).
 class OusterImuSource final : public StreamSource {
  public:
-  OusterImuSource(const std::filesystem::path& pcap, const SensorInfo& info, std::uint16_t port,
-                  const DecoderOptions& options = {},
-                  std::optional<std::size_t> ignore_size = std::nullopt);
+  OusterImuSource(std::string name, std::unique_ptr<DatagramSource> datagrams,
+                  const SensorInfo& info, const DecoderOptions& options = {});
   ~OusterImuSource() override;
   std::string name() const override { return name_; }
   std::optional<RecordingEvent> next() override;
@@ -81,10 +102,8 @@ class OusterImuSource final : public StreamSource {
   void reportDrops();
 
   std::string name_;
-  PcapReader reader_;
+  std::unique_ptr<DatagramSource> datagrams_;
   ImuPacketDecoder decoder_;
-  std::uint16_t port_;
-  std::optional<std::size_t> ignore_size_;
   std::vector<ImuSample> packet_samples_;
   std::size_t next_sample_ = 0;
   std::optional<double> last_t_s_;

@@ -1,0 +1,30 @@
+#pragma once
+// `taiga run --live`: where the sensor's packets arrive and how a live run behaves
+// (io/ouster/live.hpp, docs/live.md).
+
+#include <string>
+
+#include "taiga/core/config.hpp"
+
+namespace taiga {
+
+struct LiveConfig final : ConfigSection {
+  /// The Ouster sensor's metadata JSON (as saved by the Ouster SDK, ouster-ros or
+  /// `taiga simulate --pcap`): beam angles, packet profiles, ports.
+  std::string metadata;
+  std::string bind_address = "0.0.0.0";
+  /// UDP ports; 0: the metadata's udp_port_lidar / udp_port_imu, else 7502 / 7503.
+  int lidar_port = 0;
+  int imu_port = 0;
+  /// The run ends when no packet came for this long, s; 0: it waits until Ctrl-C.
+  double idle_timeout_s = 10.0;
+  double socket_buffer_mb = 64.0;
+  /// Scans that may wait for the odometry before the oldest is dropped (a live run stays
+  /// current rather than falling behind); dropped scans are reported.
+  int max_queued_scans = 2;
+
+  void visit(ConfigVisitor& v) override;
+  void validate() const override;
+};
+
+}  // namespace taiga

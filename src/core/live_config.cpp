@@ -1,0 +1,26 @@
+#include "taiga/core/live_config.hpp"
+
+namespace taiga {
+
+void LiveConfig::visit(ConfigVisitor& v) {
+  v.field("metadata", metadata,
+          "the Ouster sensor's metadata JSON (beam angles, packet profiles, ports)");
+  v.field("bind_address", bind_address, "local address to receive on; 0.0.0.0: every interface");
+  v.field("lidar_port", lidar_port, "UDP port of lidar packets; 0: the metadata's, else 7502");
+  v.field("imu_port", imu_port, "UDP port of IMU packets; 0: the metadata's, else 7503");
+  v.field("idle_timeout_s", idle_timeout_s,
+          "s without a packet after which the run ends; 0: it waits until Ctrl-C");
+  v.field("socket_buffer_mb", socket_buffer_mb, "MB of receive buffer per socket");
+  v.field("max_queued_scans", max_queued_scans,
+          "scans that may wait for the odometry before the oldest is dropped");
+}
+
+void LiveConfig::validate() const {
+  requireInRange("lidar_port", lidar_port, 0, 65535, "");
+  requireInRange("imu_port", imu_port, 0, 65535, "");
+  requireNonNegative("idle_timeout_s", idle_timeout_s, "s");
+  requireInRange("socket_buffer_mb", socket_buffer_mb, 0.1, 2048.0, "MB");
+  requireInRange("max_queued_scans", max_queued_scans, 1, 10000, "");
+}
+
+}  // namespace taiga
