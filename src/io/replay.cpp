@@ -25,13 +25,13 @@ ReplayReport replayCapture(const std::filesystem::path& pcap, const ReplayOption
     if (t_s < options.skip_s) continue;
     if (report.datagrams == 0) wall_start = Clock::now();
     if (options.rate > 0.0) {
-      const auto due = wall_start + std::chrono::duration_cast<Clock::duration>(
-                                        std::chrono::duration<double>((t_s - options.skip_s) /
-                                                                      options.rate));
+      const auto due =
+          wall_start + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>((t_s - options.skip_s) / options.rate));
       std::this_thread::sleep_until(due);
-      report.max_late_ms = std::max(
-          report.max_late_ms,
-          std::chrono::duration<double, std::milli>(Clock::now() - due).count());
+      report.max_late_ms =
+          std::max(report.max_late_ms,
+                   std::chrono::duration<double, std::milli>(Clock::now() - due).count());
     }
     const int port = d->destination_port + options.port_offset;
     if (port <= 0 || port > 65535)
@@ -39,7 +39,8 @@ ReplayReport replayCapture(const std::filesystem::path& pcap, const ReplayOption
                                    options.port_offset, d->destination_port, options.port_offset));
     auto it = sockets.find(port);
     if (it == sockets.end())
-      it = sockets.emplace(port, UdpSocket::connected(options.host, static_cast<std::uint16_t>(port)))
+      it = sockets
+               .emplace(port, UdpSocket::connected(options.host, static_cast<std::uint16_t>(port)))
                .first;
     if (!it->second.send(d->payload)) ++report.refused;
     ++report.datagrams;

@@ -25,8 +25,8 @@ sockaddr_in resolve(const std::string& host, std::uint16_t port) {
   addrinfo* found = nullptr;
   const int error = getaddrinfo(host.c_str(), nullptr, &hints, &found);
   if (error != 0 || found == nullptr)
-    throw InputError(fmt::format("{}:{}: cannot resolve the address: {}", host, port,
-                                 gai_strerror(error)));
+    throw InputError(
+        fmt::format("{}:{}: cannot resolve the address: {}", host, port, gai_strerror(error)));
   sockaddr_in address{};
   std::memcpy(&address, found->ai_addr, sizeof(address));
   freeaddrinfo(found);
@@ -36,7 +36,8 @@ sockaddr_in resolve(const std::string& host, std::uint16_t port) {
 
 int openSocket(const std::string& label) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw InputError(fmt::format("{}: cannot open a UDP socket: {}", label, std::strerror(errno)));
+  if (fd < 0)
+    throw InputError(fmt::format("{}: cannot open a UDP socket: {}", label, std::strerror(errno)));
   return fd;
 }
 
@@ -49,7 +50,6 @@ UdpSocket UdpSocket::bound(const std::string& address, std::uint16_t port,
   const std::string label = fmt::format("{}:{}", address, port);
   UdpSocket s(openSocket(label), label);
   const int one = 1;
-  setsockopt(s.fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
   setsockopt(s.fd_, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof(one));
   if (receive_buffer_bytes > 0) {
     // SO_RCVBUFFORCE passes net.core.rmem_max for root; otherwise the system caps the request.

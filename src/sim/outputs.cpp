@@ -82,6 +82,8 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
                               rig_error.lidar_time_offset_s == 0.0 &&
                               rig_error.lidar_clock_drift_ppm == 0.0;
   config.calibration.at_start = !(truth || stated_exactly);
+  if (!simulation.scenario().output.pcap_profile.empty())  // taiga run --live --config rig.yaml
+    config.live.metadata = std::filesystem::absolute(path.parent_path() / "capture.json").string();
   if (simulation.lidar().rows() >= 64) {
     // Dense scans: the settings of config/os0-128-handheld.yaml (docs/odometry.md, "Scale").
     config.odometry.ndt_resolution_m = 0.5;

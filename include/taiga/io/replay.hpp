@@ -11,9 +11,9 @@ namespace taiga::io {
 
 struct ReplayOptions {
   std::string host = "127.0.0.1";
-  double rate = 1.0;         ///< x the recorded pace; 0: as fast as the machine sends
-  int port_offset = 0;       ///< added to every destination port
-  double skip_s = 0.0;       ///< start this far into the capture
+  double rate = 1.0;    ///< x the recorded pace; 0: as fast as the machine sends
+  int port_offset = 0;  ///< added to every destination port
+  double skip_s = 0.0;  ///< start this far into the capture
 };
 
 struct ReplayReport {
@@ -22,7 +22,7 @@ struct ReplayReport {
   std::uint64_t refused = 0;  ///< sends the system refused (e.g. nobody listening on loopback)
   double capture_s = 0.0;     ///< capture time spanned by the datagrams sent
   double wall_s = 0.0;
-  double max_late_ms = 0.0;   ///< the latest a datagram left after its due time
+  double max_late_ms = 0.0;  ///< the latest a datagram left after its due time
 };
 
 /// Sends every UDP datagram of `pcap` (pcap_reader.hpp's formats); InputError for an unreadable

@@ -25,7 +25,8 @@ constexpr auto kPollInterval = std::chrono::milliseconds(100);  // how soon a st
 enum Stream : std::size_t { kLidar = 0, kImu = 1 };
 
 std::atomic<bool> g_stop_requested{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "a signal handler may only touch lock-free atomics");
+static_assert(std::atomic<bool>::is_always_lock_free,
+              "a signal handler may only touch lock-free atomics");
 
 }  // namespace
 
@@ -103,7 +104,8 @@ void LiveCapture::State::receive() {
         }
         ++(stream == kLidar ? stats.lidar_packets : stats.imu_packets);
         queues[stream].push_back(buffer);
-        stats.max_backlog = std::max(stats.max_backlog, queues[kLidar].size() + queues[kImu].size());
+        stats.max_backlog =
+            std::max(stats.max_backlog, queues[kLidar].size() + queues[kImu].size());
         arrived.notify_all();
       }
     }
@@ -141,7 +143,8 @@ class QueuedDatagrams final : public DatagramSource {
 /// The lidar stream, counting what the frame assembler found into the live statistics.
 class LiveLidarStream final : public StreamSource {
  public:
-  LiveLidarStream(std::shared_ptr<LiveCapture::State> state, std::unique_ptr<OusterLidarSource> lidar)
+  LiveLidarStream(std::shared_ptr<LiveCapture::State> state,
+                  std::unique_ptr<OusterLidarSource> lidar)
       : state_(std::move(state)), lidar_(std::move(lidar)) {}
   std::string name() const override { return lidar_->name(); }
   std::optional<RecordingEvent> next() override {
@@ -152,7 +155,8 @@ class LiveLidarStream final : public StreamSource {
     s.incomplete_frames = lidar_->stats().incomplete_frames;
     s.bad_packets = lidar_->stats().droppedPackets();
     if (!frame) return std::nullopt;
-    s.missing_columns += static_cast<std::uint64_t>(frame->columns_expected - frame->columns_received);
+    s.missing_columns +=
+        static_cast<std::uint64_t>(frame->columns_expected - frame->columns_received);
     return RecordingEvent(std::move(frame->scan));
   }
 
@@ -169,15 +173,19 @@ LiveCapture::LiveCapture(const LiveOptions& options) : state_(std::make_shared<S
   s.info = readSensorInfo(options.metadata);
   if (s.info.lidar_profile != LidarProfile::kOff)
     s.lidar_bytes = LidarPacketLayout::of(s.info).packet_bytes;
-  if (s.info.imu_profile != ImuProfile::kOff) s.imu_bytes = ImuPacketLayout::of(s.info).packet_bytes;
+  if (s.info.imu_profile != ImuProfile::kOff)
+    s.imu_bytes = ImuPacketLayout::of(s.info).packet_bytes;
   const auto choose = [](std::uint16_t configured, std::uint16_t metadata, std::uint16_t fallback) {
     return configured != 0 ? configured : metadata != 0 ? metadata : fallback;
   };
-  const std::uint16_t lidar_port = choose(options.lidar_port, s.info.udp_port_lidar, kDefaultLidarPort);
+  const std::uint16_t lidar_port =
+      choose(options.lidar_port, s.info.udp_port_lidar, kDefaultLidarPort);
   const std::uint16_t imu_port = choose(options.imu_port, s.info.udp_port_imu, kDefaultImuPort);
-  s.sockets.push_back(UdpSocket::bound(options.bind_address, lidar_port, options.socket_buffer_bytes));
+  s.sockets.push_back(
+      UdpSocket::bound(options.bind_address, lidar_port, options.socket_buffer_bytes));
   if (imu_port != lidar_port)
-    s.sockets.push_back(UdpSocket::bound(options.bind_address, imu_port, options.socket_buffer_bytes));
+    s.sockets.push_back(
+        UdpSocket::bound(options.bind_address, imu_port, options.socket_buffer_bytes));
   s.name = fmt::format("udp://{}:{}", options.bind_address,
                        imu_port == lidar_port ? fmt::format("{}", lidar_port)
                                               : fmt::format("{}+{}", lidar_port, imu_port));

@@ -37,11 +37,11 @@ struct LiveOptions {
 };
 
 struct LiveStats {
-  std::uint64_t lidar_packets = 0;  ///< datagrams of the lidar packet size
-  std::uint64_t imu_packets = 0;    ///< datagrams of the IMU packet size
+  std::uint64_t lidar_packets = 0;    ///< datagrams of the lidar packet size
+  std::uint64_t imu_packets = 0;      ///< datagrams of the IMU packet size
   std::uint64_t other_datagrams = 0;  ///< of neither size: not from this sensor's configuration
-  std::uint64_t kernel_drops = 0;   ///< datagrams lost to a full socket buffer
-  std::uint64_t frames = 0;         ///< scans assembled
+  std::uint64_t kernel_drops = 0;     ///< datagrams lost to a full socket buffer
+  std::uint64_t frames = 0;           ///< scans assembled
   std::uint64_t incomplete_frames = 0;
   std::uint64_t missing_columns = 0;  ///< in incomplete frames: lost packets x columns_per_packet
   std::uint64_t bad_packets = 0;      ///< of the right size that failed to decode (CRC, ...)

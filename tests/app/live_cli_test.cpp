@@ -1,0 +1,138 @@
+// Issue 24: `taiga simulate --pcap`, `taiga replay` and `taiga run --live` as users run them. A
+// simulated capture replayed over loopback and processed live gives the same trajectory as the
+// run on the capture file; SIGTERM ends a live run with every output written; bad setups get a
+// clear error.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <fstream>
+#include <future>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "../support/run_taiga.hpp"
+#include "../support/temp_dir.hpp"
+
+namespace taiga::app {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string readText(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// Ports of this test process: Ouster's 7502/7503 moved by the offset given to `taiga replay`.
+int portOffset() { return 30000 + (getpid() % 5000) * 4 - 7502; }
+
+/// The simulated rig.yaml (whose live.metadata names the capture's JSON) receiving on this
+/// process's ports.
+std::filesystem::path liveConfig(const std::filesystem::path& sim, double idle_timeout_s) {
+  YAML::Node config = YAML::LoadFile((sim / "rig.yaml").string());
+  config["live"]["bind_address"] = "127.0.0.1";
+  config["live"]["lidar_port"] = 7502 + portOffset();
+  config["live"]["imu_port"] = 7503 + portOffset();
+  config["live"]["idle_timeout_s"] = idle_timeout_s;
+  config["live"]["max_queued_scans"] = 1000;  // a slow test machine lags, and drops nothing
+  const auto path = sim / fmt::format("live_{}.yaml", idle_timeout_s);
+  std::ofstream(path) << config << "\n";
+  return path;
+}
+
+/// A 4 s walk with its capture in the low-data-rate profile (32 beams x 512 columns).
+std::filesystem::path simulate(const test::TempDir& dir) {
+  const auto sim = dir.file("sim");
+  const test::TaigaResult r = test::runTaiga(
+      "simulate --scenario mixed --duration 4 --beams 32 --columns 512 --seed 4 --pcap "
+      "RNG15_RFL8_NIR8 --out " +
+      sim.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return sim;
+}
+
+std::future<test::TaigaResult> startLive(const std::filesystem::path& config,
+                                         const std::filesystem::path& out) {
+  auto live = std::async(std::launch::async, [=] {
+    return test::runTaiga("run --live --config " + config.string() + " --out " + out.string());
+  });
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // until it listens
+  return live;
+}
+
+TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
+  test::TempDir dir;
+  const auto sim = simulate(dir);
+  const auto file_run = sim / "file_run";
+  const test::TaigaResult file =
+      test::runTaiga("run " + (sim / "capture.pcap").string() + " --config " +
+                     (sim / "rig.yaml").string() + " --out " + file_run.string());
+  ASSERT_EQ(file.exit_code, 0) << file.output;
+
+  const auto live_run = sim / "live_run";
+  auto live = startLive(liveConfig(sim, 1.5), live_run);
+  const test::TaigaResult replay = test::runTaiga(fmt::format(
+      "replay {} --rate 2 --port-offset {}", (sim / "capture.pcap").string(), portOffset()));
+  ASSERT_EQ(replay.exit_code, 0) << replay.output;
+  const test::TaigaResult r = live.get();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("0 incomplete"));
+  EXPECT_THAT(r.output, HasSubstr("0 scans dropped"));
+
+  // Every packet arrived, so every scan and IMU sample is the file's: the same trajectory.
+  const std::string expected = readText(file_run / "trajectory.tum");
+  ASSERT_GT(expected.size(), 1000u);
+  EXPECT_EQ(readText(live_run / "trajectory.tum"), expected);
+  EXPECT_EQ(readText(live_run / "trajectory_imu.tum"), readText(file_run / "trajectory_imu.tum"));
+  const nlohmann::json summary = nlohmann::json::parse(readText(live_run / "summary.json"));
+  EXPECT_EQ(summary["live"]["frames"], 40);
+  EXPECT_EQ(summary["live"]["missing_columns"], 0);
+  EXPECT_THAT(summary["live"]["stop_reason"].get<std::string>(), HasSubstr("no packet"));
+}
+
+TEST(LiveCli, SigtermEndsALiveRunWithItsOutputsWritten) {
+  test::TempDir dir;
+  const auto sim = simulate(dir);
+  const auto config = liveConfig(sim, 0.0);  // waits for packets until stopped
+  const auto out = sim / "stopped_run";
+  auto live = startLive(config, out);
+  ASSERT_EQ(test::runTaiga(fmt::format("replay {} --rate 4 --port-offset {}",
+                                       (sim / "capture.pcap").string(), portOffset()))
+                .exit_code,
+            0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // Anchored at the executable: not the shells that run taiga and pkill.
+  ASSERT_EQ(std::system(("pkill -TERM -f -- '^" + std::string(TAIGA_EXECUTABLE) +
+                         " run --live --config " + config.string() + "'")
+                            .c_str()),
+            0);
+  const test::TaigaResult r = live.get();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json summary = nlohmann::json::parse(readText(out / "summary.json"));
+  EXPECT_THAT(summary["live"]["stop_reason"].get<std::string>(), HasSubstr("stop requested"));
+  EXPECT_GT(summary["scans_processed"].get<int>(), 30);
+  EXPECT_TRUE(std::filesystem::exists(out / "map.las"));
+  EXPECT_GT(readText(out / "trajectory.tum").size(), 1000u);
+}
+
+TEST(LiveCli, ALiveRunWithoutMetadataOrWithARecordingSaysWhy) {
+  test::TempDir dir;
+  const auto rig = dir.write("rig.yaml", "rig: {}\n");
+  const test::TaigaResult no_metadata =
+      test::runTaiga("run --live --config " + rig.string() + " --out " + dir.file("x").string());
+  EXPECT_EQ(no_metadata.exit_code, 2);
+  EXPECT_THAT(no_metadata.output, HasSubstr("live.metadata"));
+  const test::TaigaResult both =
+      test::runTaiga("run " + rig.string() + " --live --out " + dir.file("y").string());
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_THAT(both.output, HasSubstr("either a RECORDING or --live"));
+}
+
+}  // namespace
+}  // namespace taiga::app
