@@ -37,7 +37,12 @@ sys.stdout.buffer.write(b"\x01"+bytes(h)+struct.pack("<3iH4BhHd",1000,2000,3000,
       for json in ../shared/data/ouster/*.json; do
         [ -f "$json" ] && { printf '\000'; cat "$json"; } > "$corpus/$(basename "$json")"
       done
-      head -c 4096 /dev/zero | tr '\000' '\001' > "$corpus/packets" ;;
+      head -c 4096 /dev/zero | tr '\000' '\001' > "$corpus/packets"
+      # Live datagrams (selector 1): a 304-byte lidar packet (type 1) and a 48-byte IMU packet of
+      # the fuzz target's small sensor, each after its 2-byte length.
+      /usr/bin/python3 -c 'import struct,sys
+lidar=bytearray(304); lidar[0]=1; imu=bytearray(48)
+sys.stdout.buffer.write(b"\x01"+struct.pack("<H",304)+bytes(lidar)+struct.pack("<H",48)+bytes(imu))' > "$corpus/live" ;;
     fuzz_trees_csv)
       printf 'id,x_m,y_m,z_m,dbh_m,height_m,lean_deg,lean_azimuth_deg,species,x_bh_m,y_bh_m\n0,3.1,24.2,-0.26,0.265,19.2,1.8,313.6,pine,3.17,24.14\n' > "$corpus/simulator"
       printf 'id,x_m,y_m,z_m,x_bh_m,y_bh_m,dbh_m,dbh_sigma_m,height_m,lean_deg,lean_azimuth_deg,points,fit_rms_m,arc_deg,slices,quality\n1,-40.1,-7.5,0.37,-40.2,-7.6,0.159,0.013,15.33,3.61,211.3,24,0.0153,150,4,partial\n' > "$corpus/taiga" ;;

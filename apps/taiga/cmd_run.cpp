@@ -108,9 +108,9 @@ void printLive(const io::ouster::LiveStats& l, const pipeline::RealtimeReport& r
       l.lidar_packets, l.imu_packets, l.frames, l.incomplete_frames, l.missing_columns,
       l.bad_packets, l.other_datagrams, l.kernel_drops, l.stop_reason);
   fmt::print(
-      "           {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, {:.1f} "
-      "ms max from a scan's last packet to its pose\n",
-      r.dropped_scans, r.latency_p50_ms, r.latency_p95_ms, r.latency_max_ms);
+      "           {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p99, {:.1f} "
+      "ms max from a scan's assembly to its pose\n",
+      r.dropped_scans, r.latency_p50_ms, r.latency_p99_ms, r.latency_max_ms);
 }
 
 int run(const RunOptions& options) {

@@ -124,6 +124,7 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
     realtime = RealtimeReport{.dropped_scans = feed.droppedScans(),
                               .latency_p50_ms = percentile(latencies_ms, 50.0),
                               .latency_p95_ms = percentile(latencies_ms, 95.0),
+                              .latency_p99_ms = percentile(latencies_ms, 99.0),
                               .latency_max_ms = percentile(latencies_ms, 100.0)};
   return scans;
 }

@@ -142,6 +142,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
                      {"latency_ms",
                       {{"p50", s.realtime->latency_p50_ms},
                        {"p95", s.realtime->latency_p95_ms},
+                       {"p99", s.realtime->latency_p99_ms},
                        {"max", s.realtime->latency_max_ms}}}};
   }
   if (s.live) {

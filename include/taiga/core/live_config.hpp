@@ -20,8 +20,9 @@ struct LiveConfig final : ConfigSection {
   double idle_timeout_s = 10.0;
   double socket_buffer_mb = 64.0;
   /// Scans that may wait for the odometry before the oldest is dropped (a live run stays
-  /// current rather than falling behind); dropped scans are reported.
-  int max_queued_scans = 2;
+  /// current rather than falling behind); dropped scans are reported. 5 (0.5 s at 10 Hz)
+  /// absorbs the bursts of loop-closure verification on two cores.
+  int max_queued_scans = 5;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

@@ -53,7 +53,7 @@ struct RunOptions {
 /// and the latency from a scan's delivery to its pose.
 struct RealtimeReport {
   std::size_t dropped_scans = 0;
-  double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_max_ms = 0.0;
+  double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_p99_ms = 0.0, latency_max_ms = 0.0;
 };
 
 /// The georeferencing at the end of a run whose recording has GNSS fixes.

@@ -30,6 +30,12 @@ static_assert(std::atomic<bool>::is_always_lock_free,
 
 }  // namespace
 
+DatagramKind classifyDatagram(std::size_t bytes, std::size_t lidar_bytes, std::size_t imu_bytes) {
+  if (bytes == lidar_bytes) return DatagramKind::kLidar;
+  if (bytes == imu_bytes) return DatagramKind::kImu;
+  return DatagramKind::kOther;
+}
+
 void requestLiveStop() { g_stop_requested.store(true); }
 bool liveStopRequested() { return g_stop_requested.load(); }
 
@@ -90,10 +96,11 @@ void LiveCapture::State::receive() {
       UdpSocket& socket = sockets[i];
       while (socket.receive(buffer)) {  // drain: the kernel buffer is the only other queue
         last_packet = Clock::now();
-        const Stream stream = buffer.size() == lidar_bytes ? kLidar : kImu;
+        const DatagramKind kind = classifyDatagram(buffer.size(), lidar_bytes, imu_bytes);
+        const Stream stream = kind == DatagramKind::kLidar ? kLidar : kImu;
         std::lock_guard lock(mutex);
         stats.kernel_drops = socket.kernelDrops();
-        if (buffer.size() != lidar_bytes && buffer.size() != imu_bytes) {
+        if (kind == DatagramKind::kOther) {
           ++stats.other_datagrams;
           if (!std::exchange(warned_other, true))
             logger().warn(

@@ -49,6 +49,11 @@ struct LiveStats {
   std::string stop_reason;            ///< why the streams ended; empty while they run
 };
 
+/// Which stream a datagram belongs to: the live receiver sorts them by size, since a lidar and an
+/// IMU packet of the metadata's profiles never have the same size (a port may carry both).
+enum class DatagramKind { kLidar, kImu, kOther };
+DatagramKind classifyDatagram(std::size_t bytes, std::size_t lidar_bytes, std::size_t imu_bytes);
+
 /// Ends every live capture's streams; async-signal-safe (for SIGINT and SIGTERM handlers).
 void requestLiveStop();
 bool liveStopRequested();
