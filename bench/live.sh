@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # taiga run --live on a simulated Ouster capture replayed over loopback (issue 24): at each pace,
 # whether scans were dropped or packets lost, whether the trajectory equals the run on the
-# capture file, and the latency from a scan's assembly to its pose (summary.json "realtime").
+# capture file, the latency from a scan's assembly to its pose inside taiga (summary.json
+# "realtime"), and end to end, from the packet's sending to the pose datagram's arrival
+# (live.pose_udp, bench/pose_listener.py and bench/pose_latency.py).
 #
 # Usage: bench/live.sh [OUT_DIR]   (environment: TAIGA, SCENARIO, DURATION, BEAMS, SEED, RATES)
 # Example (the issue's figure: a 60 s full OS0-128 capture at 1x, 2x and 5x):
@@ -26,15 +28,19 @@ for rate in $rates; do
 import sys, yaml
 config = yaml.safe_load(open(sys.argv[1]))
 offset = int(sys.argv[3])
-config["live"].update(lidar_port=7502 + offset, imu_port=7503 + offset, idle_timeout_s=3)
+config["live"].update(lidar_port=7502 + offset, imu_port=7503 + offset, idle_timeout_s=3,
+                      pose_udp=f"127.0.0.1:{9870 + offset}")
 yaml.safe_dump(config, open(sys.argv[2], "w"))
 PY
   rm -rf "$out/live_$rate"
+  python3 "$(dirname "$0")/pose_listener.py" $((9870 + offset)) "$out/poses_$rate.txt" 8 &
+  listener=$!
   "$taiga" run --live --config "$config" --out "$out/live_$rate" >"$out/live_$rate.log" 2>&1 &
   live=$!
   sleep 1
   "$taiga" replay "$sim/capture.pcap" --rate "$rate" --port-offset "$offset" >"$out/replay_$rate.log"
   wait "$live" || true
+  wait "$listener"
 done
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 python3 - "$out" $rates <<'PY'
@@ -52,3 +58,7 @@ for rate in rates:
           f"{l['missing_columns']} | {l['kernel_drops']} | {'identical' if same else 'differs'} | "
           f"{lat['p50']:.1f} / {lat['p99']:.1f} / {lat['max']:.1f} |")
 PY
+for rate in $rates; do
+  echo "pose stream at ${rate}x, end to end:"
+  python3 "$(dirname "$0")/pose_latency.py" "$out/poses_$rate.txt" "$out/replay_$rate.log" "$rate"
+done

@@ -22,6 +22,8 @@ int runReplay(const ReplayCommandOptions& options) {
       r.datagrams, static_cast<double>(r.bytes) / 1e6, options.replay.host, r.capture_s, r.wall_s,
       r.max_late_ms,
       r.refused > 0 ? fmt::format("; {} refused (nobody listening?)", r.refused) : "");
+  fmt::print("first datagram sent at Unix time {:.6f} s, its capture time {:.6f} s\n",
+             r.start_unix_s, r.first_capture_s);
   return r.datagrams > 0 ? kExitOk : kExitBadInput;
 }
 

@@ -13,6 +13,8 @@ void LiveConfig::visit(ConfigVisitor& v) {
   v.field("socket_buffer_mb", socket_buffer_mb, "MB of receive buffer per socket");
   v.field("max_queued_scans", max_queued_scans,
           "scans that may wait for the odometry before the oldest is dropped");
+  v.field("pose_udp", pose_udp,
+          "host:port receiving every scan's and IMU sample's pose as a JSON datagram; empty: none");
 }
 
 void LiveConfig::validate() const {

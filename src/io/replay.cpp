@@ -19,15 +19,22 @@ ReplayReport replayCapture(const std::filesystem::path& pcap, const ReplayOption
   ReplayReport report;
   std::optional<std::int64_t> first_ns, last_ns;
   Clock::time_point wall_start;
+  double first_sent_s = 0.0;  // capture time of the first datagram sent, from the first one
   while (const std::optional<ouster::UdpDatagram> d = reader.next()) {
     if (!first_ns) first_ns = d->capture_time_ns;
     const double t_s = 1e-9 * static_cast<double>(d->capture_time_ns - *first_ns);
     if (t_s < options.skip_s) continue;
-    if (report.datagrams == 0) wall_start = Clock::now();
+    if (report.datagrams == 0) {
+      first_sent_s = t_s;
+      wall_start = Clock::now();
+      report.start_unix_s =
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+      report.first_capture_s = 1e-9 * static_cast<double>(d->capture_time_ns);
+    }
     if (options.rate > 0.0) {
       const auto due =
           wall_start + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double>((t_s - options.skip_s) / options.rate));
+                           std::chrono::duration<double>((t_s - first_sent_s) / options.rate));
       std::this_thread::sleep_until(due);
       report.max_late_ms =
           std::max(report.max_late_ms,
@@ -49,7 +56,7 @@ ReplayReport replayCapture(const std::filesystem::path& pcap, const ReplayOption
   }
   if (report.datagrams > 0) {
     report.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
-    report.capture_s = 1e-9 * static_cast<double>(*last_ns - *first_ns) - options.skip_s;
+    report.capture_s = 1e-9 * static_cast<double>(*last_ns - *first_ns) - first_sent_s;
   }
   return report;
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "online_trees.hpp"
+#include "pose_stream.hpp"
 #include "recording_feed.hpp"
 #include "run_georef.hpp"
 #include "run_health.hpp"
@@ -197,7 +198,7 @@ bool calibratesAtStart(const SystemConfig& config) {
 RunSummary runRecording(io::Recording& recording, const std::filesystem::path& recording_path,
                         const SystemConfig& config,
                         std::optional<CalibrationRunReport> calibration, const RunOptions& options,
-                        const io::ouster::LiveCapture* live) {
+                        io::ouster::LiveCapture* live) {
   const std::filesystem::path& out = options.out_dir;
   std::deque<io::RecordingEvent> read_ahead;
   SlamSystem slam(config,
@@ -212,6 +213,12 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   slam.addObserver(scan_log);
   slam.addObserver(health);
   slam.addObserver(gnss);
+  std::optional<PoseStream> pose_stream;
+  if (!config.live.pose_udp.empty()) {
+    slam.addObserver(pose_stream.emplace(config.live.pose_udp, config, live == nullptr));
+    if (live != nullptr)
+      live->setImuTap([&pose_stream](const ImuSample& sample) { pose_stream->imuArrived(sample); });
+  }
   std::optional<OnlineTrees> online_trees;
   if (config.mapping.trees)
     slam.addObserver(online_trees.emplace(slam.keyframes(), out / "trees.csv"));
@@ -221,7 +228,10 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   summary.scans = feedRecording(recording, std::move(read_ahead), options,
                                 live != nullptr ? &config.live : nullptr, slam, scan_log, health,
                                 summary.realtime);
-  if (live != nullptr) summary.live = live->stats();
+  if (live != nullptr) {
+    live->setImuTap(nullptr);  // before pose_stream goes
+    summary.live = live->stats();
+  }
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);

@@ -23,6 +23,9 @@ struct LiveConfig final : ConfigSection {
   /// current rather than falling behind); dropped scans are reported. 5 (0.5 s at 10 Hz)
   /// absorbs the bursts of loop-closure verification on two cores.
   int max_queued_scans = 5;
+  /// "host:port": every scan's and IMU sample's pose as a JSON datagram (docs/live.md, "Pose
+  /// stream"), on a live run and on a recording alike; empty: none.
+  std::string pose_udp;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

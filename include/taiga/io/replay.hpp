@@ -23,6 +23,9 @@ struct ReplayReport {
   double capture_s = 0.0;     ///< capture time spanned by the datagrams sent
   double wall_s = 0.0;
   double max_late_ms = 0.0;  ///< the latest a datagram left after its due time
+  /// When the first datagram was sent (Unix time, s) and its capture time (s): a datagram of
+  /// capture time t was due at start_unix_s + (t - first_capture_s) / rate, for latency checks.
+  double start_unix_s = 0.0, first_capture_s = 0.0;
 };
 
 /// Sends every UDP datagram of `pcap` (pcap_reader.hpp's formats); InputError for an unreadable

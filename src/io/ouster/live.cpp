@@ -6,12 +6,15 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <functional>
+#include <optional>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "taiga/core/log.hpp"
 #include "taiga/io/ouster/capture.hpp"
+#include "taiga/io/ouster/imu_packet.hpp"
 #include "taiga/io/udp_socket.hpp"
 
 namespace taiga::io::ouster {
@@ -54,7 +57,14 @@ struct LiveCapture::State {
   LiveStats stats;
   std::thread receiver;
 
+  std::mutex tap_mutex;
+  std::function<void(const ImuSample&)> imu_tap;
+  std::optional<ImuPacketDecoder> tap_decoder;
+  std::vector<ImuSample> tap_samples;
+
   void receive();
+  /// Hands an IMU packet's samples to the tap, on the receiver thread, as it arrives.
+  void tapImu(std::span<const std::uint8_t> packet);
   void close(std::string reason);
   /// The next datagram of `stream` into `buffer`; false at the end.
   bool pop(Stream stream, std::vector<std::uint8_t>& buffer);
@@ -97,6 +107,7 @@ void LiveCapture::State::receive() {
       while (socket.receive(buffer)) {  // drain: the kernel buffer is the only other queue
         last_packet = Clock::now();
         const DatagramKind kind = classifyDatagram(buffer.size(), lidar_bytes, imu_bytes);
+        if (kind == DatagramKind::kImu) tapImu(buffer);
         const Stream stream = kind == DatagramKind::kLidar ? kLidar : kImu;
         std::lock_guard lock(mutex);
         stats.kernel_drops = socket.kernelDrops();
@@ -118,6 +129,13 @@ void LiveCapture::State::receive() {
     }
   }
   close("the live capture was closed");
+}
+
+void LiveCapture::State::tapImu(std::span<const std::uint8_t> packet) {
+  std::lock_guard lock(tap_mutex);
+  if (!imu_tap) return;
+  if (tap_decoder->decode(packet, tap_samples) != PacketStatus::kOk) return;
+  for (const ImuSample& sample : tap_samples) imu_tap(sample);
 }
 
 bool LiveCapture::State::pop(Stream stream, std::vector<std::uint8_t>& buffer) {
@@ -232,6 +250,12 @@ Recording LiveCapture::recording(double lidar_time_offset_s) {
         fmt::format("{} (IMU)", s.name), std::make_unique<QueuedDatagrams>(state_, kImu), s.info,
         s.options.decoder));
   return Recording(s.name, std::move(streams), lidar_time_offset_s);
+}
+
+void LiveCapture::setImuTap(std::function<void(const ImuSample&)> tap) {
+  std::lock_guard lock(state_->tap_mutex);
+  if (!state_->tap_decoder) state_->tap_decoder.emplace(state_->info, state_->options.decoder);
+  state_->imu_tap = std::move(tap);
 }
 
 LiveStats LiveCapture::stats() const {

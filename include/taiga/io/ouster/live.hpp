@@ -17,6 +17,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -74,6 +75,10 @@ class LiveCapture {
   /// openRecording. The recording may outlive this object: its streams then end.
   Recording recording(double lidar_time_offset_s);
   LiveStats stats() const;
+  /// `tap` gets every IMU sample (IMU frame) as its packet arrives, on the receiver thread,
+  /// before the recording delivers it in time order: for poses at IMU rate without waiting for
+  /// the scan the sample falls into. It must be quick and must not throw.
+  void setImuTap(std::function<void(const ImuSample&)> tap);
 
   struct State;  ///< sockets, receiver thread and queues; shared with the recording's streams
 
