@@ -1,5 +1,7 @@
 #include "taiga/core/live_config.hpp"
 
+#include <charconv>
+
 namespace taiga {
 
 void LiveConfig::visit(ConfigVisitor& v) {
@@ -23,6 +25,18 @@ void LiveConfig::validate() const {
   requireNonNegative("idle_timeout_s", idle_timeout_s, "s");
   requireInRange("socket_buffer_mb", socket_buffer_mb, 0.1, 2048.0, "MB");
   requireInRange("max_queued_scans", max_queued_scans, 1, 10000, "");
+  if (!pose_udp.empty() && !udpAddressPort(pose_udp))
+    throw ConfigError("pose_udp", "expected host:port (e.g. 127.0.0.1:9870), got '" + pose_udp + "'");
+}
+
+std::optional<std::pair<std::string, std::uint16_t>> udpAddressPort(const std::string& text) {
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) return std::nullopt;
+  int port = 0;
+  const char* last = text.data() + text.size();
+  const auto [end, error] = std::from_chars(text.data() + colon + 1, last, port);
+  if (error != std::errc() || end != last || port <= 0 || port > 65535) return std::nullopt;
+  return std::pair{text.substr(0, colon), static_cast<std::uint16_t>(port)};
 }
 
 }  // namespace taiga

@@ -12,18 +12,10 @@ namespace {
 constexpr std::size_t kMaxRecentSamples = 2000;
 
 io::UdpSocket openSocket(const std::string& address) {
-  const std::size_t colon = address.rfind(':');
-  int port = 0;
-  if (colon != std::string::npos) {
-    try {
-      port = std::stoi(address.substr(colon + 1));
-    } catch (const std::exception&) {
-    }
-  }
-  if (colon == std::string::npos || colon == 0 || port <= 0 || port > 65535)
-    throw InputError(fmt::format("live.pose_udp: expected host:port (e.g. 127.0.0.1:9870), found '{}'",
-                                 address));
-  return io::UdpSocket::connected(address.substr(0, colon), static_cast<std::uint16_t>(port));
+  const auto host_port = udpAddressPort(address);
+  if (!host_port)
+    throw InputError(fmt::format("live.pose_udp: expected host:port, found '{}'", address));
+  return io::UdpSocket::connected(host_port->first, host_port->second);
 }
 
 }  // namespace

@@ -242,6 +242,13 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     if (r.attempt.accepted && (reattached.empty() || reattached.back().segment != r.segment))
       reattached.push_back(  // the first link of each segment
           {r.segment, r.t_s, r.attempt.correction_m, r.attempt.correction_deg, r.attempt.overlap});
+  if (live != nullptr && summary.live->lidar_packets == 0)
+    throw InputError(fmt::format(
+        "{}: no lidar packet arrived ({} IMU packets, {} other datagrams; {}): is the sensor "
+        "sending to this host (its udp_dest) and to these ports (live.lidar_port, "
+        "live.imu_port)?",
+        recording_path.string(), summary.live->imu_packets, summary.live->other_datagrams,
+        summary.live->stop_reason));
   if (trajectories.odometry().empty())
     throw InputError(fmt::format(
         "{}: no scan could be processed ({} scans, {} IMU samples): the odometry needs at least "

@@ -6,17 +6,23 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
+
+#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
 #include <fstream>
+#include <atomic>
 #include <future>
+#include <map>
+#include <sstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 
 #include "../support/run_taiga.hpp"
+#include "taiga/io/udp_socket.hpp"
 #include "../support/temp_dir.hpp"
 
 namespace taiga::app {
@@ -41,6 +47,7 @@ std::filesystem::path liveConfig(const std::filesystem::path& sim, double idle_t
   config["live"]["imu_port"] = 7503 + portOffset();
   config["live"]["idle_timeout_s"] = idle_timeout_s;
   config["live"]["max_queued_scans"] = 1000;  // a slow test machine lags, and drops nothing
+  config["live"]["pose_udp"] = fmt::format("127.0.0.1:{}", 7504 + portOffset());
   const auto path = sim / fmt::format("live_{}.yaml", idle_timeout_s);
   std::ofstream(path) << config << "\n";
   return path;
@@ -55,6 +62,50 @@ std::filesystem::path simulate(const test::TempDir& dir) {
       sim.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   return sim;
+}
+
+/// The pose stream's datagrams (live.pose_udp), parsed, collected on a thread until stop().
+class PoseReceiver {
+ public:
+  PoseReceiver()
+      : socket_(io::UdpSocket::bound("127.0.0.1", static_cast<std::uint16_t>(7504 + portOffset()),
+                                     8 << 20)),
+        thread_([this] { receive(); }) {}
+  std::vector<nlohmann::json> stop() {
+    done_ = true;
+    thread_.join();
+    return poses_;
+  }
+
+ private:
+  void receive() {
+    const io::UdpSocket* sockets[] = {&socket_};
+    std::vector<std::uint8_t> datagram;
+    while (!done_) {
+      io::waitReadable(sockets, std::chrono::milliseconds(50));
+      while (socket_.receive(datagram)) poses_.push_back(nlohmann::json::parse(datagram));
+    }
+  }
+  io::UdpSocket socket_;
+  std::atomic<bool> done_{false};
+  std::vector<nlohmann::json> poses_;
+  std::thread thread_;
+};
+
+/// Rows "t x y z ..." of a TUM file by time (ns), positions only.
+std::map<long long, Eigen::Vector3d> tumPositions(const std::filesystem::path& path) {
+  std::map<long long, Eigen::Vector3d> rows;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double t = 0.0;
+    Eigen::Vector3d p;
+    fields >> t >> p.x() >> p.y() >> p.z();
+    rows[std::llround(t * 1e4)] = p;  // 0.1 ms keys: the stream prints t_s to the microsecond
+  }
+  return rows;
 }
 
 std::future<test::TaigaResult> startLive(const std::filesystem::path& config,
@@ -76,6 +127,7 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
   ASSERT_EQ(file.exit_code, 0) << file.output;
 
   const auto live_run = sim / "live_run";
+  PoseReceiver pose_receiver;
   auto live = startLive(liveConfig(sim, 1.5), live_run);
   const test::TaigaResult replay = test::runTaiga(fmt::format(
       "replay {} --rate 2 --port-offset {}", (sim / "capture.pcap").string(), portOffset()));
@@ -94,6 +146,30 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
   EXPECT_EQ(summary["live"]["frames"], 40);
   EXPECT_EQ(summary["live"]["missing_columns"], 0);
   EXPECT_THAT(summary["live"]["stop_reason"].get<std::string>(), HasSubstr("no packet"));
+
+  // The pose stream: every published scan pose (trajectory_online.tum), and IMU-rate poses
+  // dead-reckoned from the latest one as their packets arrived, near the run's IMU-rate poses.
+  const std::vector<nlohmann::json> poses = pose_receiver.stop();
+  const auto online = tumPositions(live_run / "trajectory_online.tum");
+  const auto imu_rate = tumPositions(live_run / "trajectory_imu.tum");
+  std::size_t scans = 0, imu = 0, imu_near = 0;
+  for (const nlohmann::json& pose : poses) {
+    const Eigen::Vector3d p(pose["p"][0], pose["p"][1], pose["p"][2]);
+    const long long key = std::llround(pose["t_s"].get<double>() * 1e4);
+    if (pose["type"] == "scan") {
+      ++scans;
+      ASSERT_TRUE(online.contains(key)) << pose.dump();
+      EXPECT_LT((online.at(key) - p).norm(), 1e-3) << pose.dump();
+      EXPECT_EQ(pose["status"], "ok");
+    } else {
+      ++imu;
+      const auto it = imu_rate.find(key);
+      if (it != imu_rate.end() && (it->second - p).norm() < 0.05) ++imu_near;
+    }
+  }
+  EXPECT_EQ(scans, online.size());
+  EXPECT_GT(imu, 200u);  // 200 Hz over the 1.4 s after the odom frame is levelled
+  EXPECT_GT(imu_near, imu * 9 / 10);
 }
 
 TEST(LiveCli, SigtermEndsALiveRunWithItsOutputsWritten) {
@@ -121,7 +197,7 @@ TEST(LiveCli, SigtermEndsALiveRunWithItsOutputsWritten) {
   EXPECT_GT(readText(out / "trajectory.tum").size(), 1000u);
 }
 
-TEST(LiveCli, ALiveRunWithoutMetadataOrWithARecordingSaysWhy) {
+TEST(LiveCli, ALiveRunWithoutMetadataWithARecordingOrABadPoseAddressSaysWhy) {
   test::TempDir dir;
   const auto rig = dir.write("rig.yaml", "rig: {}\n");
   const test::TaigaResult no_metadata =
@@ -132,6 +208,11 @@ TEST(LiveCli, ALiveRunWithoutMetadataOrWithARecordingSaysWhy) {
       test::runTaiga("run " + rig.string() + " --live --out " + dir.file("y").string());
   EXPECT_EQ(both.exit_code, 2);
   EXPECT_THAT(both.output, HasSubstr("either a RECORDING or --live"));
+  const auto bad_pose = dir.write("pose.yaml", "live:\n  pose_udp: 9870\n");
+  const test::TaigaResult pose = test::runTaiga("run --live --config " + bad_pose.string() +
+                                                " --out " + dir.file("z").string());
+  EXPECT_EQ(pose.exit_code, 2);
+  EXPECT_THAT(pose.output, HasSubstr("live.pose_udp: expected host:port"));
 }
 
 }  // namespace

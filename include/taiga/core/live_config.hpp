@@ -2,7 +2,10 @@
 // `taiga run --live`: where the sensor's packets arrive and how a live run behaves
 // (io/ouster/live.hpp, docs/live.md).
 
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "taiga/core/config.hpp"
 
@@ -30,5 +33,8 @@ struct LiveConfig final : ConfigSection {
   void visit(ConfigVisitor& v) override;
   void validate() const override;
 };
+
+/// "host:port" split, or nothing when `text` is not one (port 1-65535).
+std::optional<std::pair<std::string, std::uint16_t>> udpAddressPort(const std::string& text);
 
 }  // namespace taiga
