@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs every Debian package taiga needs to build, test and benchmark, and the Node.js package
-# that tests use as an independent LAS reader (tools/las-check).
+# Installs every Debian package taiga needs to build, test and benchmark, and the Node.js packages
+# that tests use: an independent LAS reader (tools/las-check) and Foxglove's WebSocket protocol
+# client (tools/foxglove-check).
 # Idempotent and non-interactive: installs only what is missing, runs `apt-get update` first when it
 # has to install anything. Uses sudo when not run as root.
 set -euo pipefail
@@ -15,6 +16,8 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   # recordings: Ouster captures, ROS1 bags
   libpcap-dev librosbag-storage-dev libsensor-msgs-dev libstd-msgs-dev liblzf-dev
+  # live streams: the Foxglove WebSocket server
+  libwebsocketpp-dev libasio-dev
   # estimation, parallel loops, nearest neighbours, geodesy, ray casting for the simulator
   libceres-dev libtbb-dev libnanoflann-dev robin-map-dev libproj-dev proj-data libembree-dev
   # reference implementations (PCL's NDT/GICP) for tests and benchmarks, plots
@@ -35,12 +38,14 @@ for package in "${packages[@]}"; do
 done
 
 install_node_tools() {
-  local dir=tools/las-check
-  if [ ! -d "$dir/node_modules" ] || [ "$dir/package-lock.json" -nt "$dir/node_modules" ]; then
-    echo "setup: installing the Node.js packages of $dir"
-    (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
-    touch "$dir/node_modules"
-  fi
+  local dir
+  for dir in tools/las-check tools/foxglove-check; do
+    if [ ! -d "$dir/node_modules" ] || [ "$dir/package-lock.json" -nt "$dir/node_modules" ]; then
+      echo "setup: installing the Node.js packages of $dir"
+      (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+      touch "$dir/node_modules"
+    fi
+  done
 }
 
 if [ ${#missing[@]} -eq 0 ]; then

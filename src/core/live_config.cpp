@@ -17,6 +17,9 @@ void LiveConfig::visit(ConfigVisitor& v) {
           "scans that may wait for the odometry before the oldest is dropped");
   v.field("pose_udp", pose_udp,
           "host:port receiving every scan's and IMU sample's pose as a JSON datagram; empty: none");
+  v.field("foxglove", foxglove,
+          "host:port of a Foxglove WebSocket server showing the run (e.g. 0.0.0.0:8765); empty: "
+          "none");
 }
 
 void LiveConfig::validate() const {
@@ -26,7 +29,10 @@ void LiveConfig::validate() const {
   requireInRange("socket_buffer_mb", socket_buffer_mb, 0.1, 2048.0, "MB");
   requireInRange("max_queued_scans", max_queued_scans, 1, 10000, "");
   if (!pose_udp.empty() && !udpAddressPort(pose_udp))
-    throw ConfigError("pose_udp", "expected host:port (e.g. 127.0.0.1:9870), got '" + pose_udp + "'");
+    throw ConfigError("pose_udp",
+                      "expected host:port (e.g. 127.0.0.1:9870), got '" + pose_udp + "'");
+  if (!foxglove.empty() && !udpAddressPort(foxglove))
+    throw ConfigError("foxglove", "expected host:port (e.g. 0.0.0.0:8765), got '" + foxglove + "'");
 }
 
 std::optional<std::pair<std::string, std::uint16_t>> udpAddressPort(const std::string& text) {

@@ -2,7 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
+#include "foxglove_stream.hpp"
 #include "taiga/core/errors.hpp"
+#include "taiga/core/live_config.hpp"
 
 namespace taiga::pipeline {
 namespace {
@@ -10,6 +14,9 @@ namespace {
 /// Samples kept to carry a new scan's state forward: far more than arrive during a scan's
 /// processing, at any IMU rate.
 constexpr std::size_t kMaxRecentSamples = 2000;
+/// IMU-rate poses further than this from the latest scan pose are not sent: dead reckoning
+/// drifts by metres in seconds.
+constexpr double kMaxDeadReckoning_s = 1.0;
 
 io::UdpSocket openSocket(const std::string& address) {
   const auto host_port = udpAddressPort(address);
@@ -20,14 +27,24 @@ io::UdpSocket openSocket(const std::string& address) {
 
 }  // namespace
 
-PoseStream::PoseStream(const std::string& address, const SystemConfig& config,
-                       bool imu_from_system)
-    : socket_(openSocket(address)),
+PoseStream::PoseStream(const std::string& udp_address, stream::FoxgloveServer* foxglove,
+                       const SystemConfig& config, bool imu_from_system)
+    : foxglove_(foxglove),
       imu_from_system_(imu_from_system),
       R_body_imu_(config.rig.T_body_imu.rotation()),
-      gravity_mps2_(config.odometry.imu.gravity_mps2) {}
+      gravity_mps2_(config.odometry.imu.gravity_mps2) {
+  if (!udp_address.empty()) socket_ = openSocket(udp_address);
+}
 
 void PoseStream::send(const char* type, double t_s, const imu::NavState& s, const char* status) {
+  ++sent_;
+  if (foxglove_ != nullptr) {
+    const std::size_t topic = status != nullptr ? kPoseTopic : kImuPoseTopic;
+    if (foxglove_->subscribed(topic))
+      foxglove_->publish(topic, static_cast<std::uint64_t>(std::llround(t_s * 1e9)),
+                         poseInFrameJson(t_s, lie::SE3(s.R_world_body, s.p_world)));
+  }
+  if (!socket_) return;
   const Eigen::Quaterniond q = s.R_world_body.quaternion();
   std::string text = fmt::format(
       R"({{"type":"{}","t_s":{:.6f},"frame":"map","p":[{:.4f},{:.4f},{:.4f}],"q":[{:.6f},{:.6f},{:.6f},{:.6f}],"v":[{:.4f},{:.4f},{:.4f}])",
@@ -35,18 +52,18 @@ void PoseStream::send(const char* type, double t_s, const imu::NavState& s, cons
       s.v_world.x(), s.v_world.y(), s.v_world.z());
   if (status != nullptr) text += fmt::format(R"(,"status":"{}")", status);
   text += "}\n";
-  socket_.send(std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-  ++sent_;
+  socket_->send(std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
 
 void PoseStream::onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) {
   std::lock_guard lock(mutex_);
   const lie::SE3 T_map_body = T_map_odom * scan.T_odom_body;
   const Eigen::Matrix3d R_map_odom = T_map_odom.rotation().matrix();
-  Anchor anchor{.t_s = scan.t_s,
-                .state = {T_map_body.rotation(), T_map_body.translation(), R_map_odom * scan.v_odom},
-                .bias = scan.bias,
-                .gravity_map = R_map_odom * Eigen::Vector3d(0.0, 0.0, -gravity_mps2_)};
+  Anchor anchor{
+      .t_s = scan.t_s,
+      .state = {T_map_body.rotation(), T_map_body.translation(), R_map_odom * scan.v_odom},
+      .bias = scan.bias,
+      .gravity_map = R_map_odom * Eigen::Vector3d(0.0, 0.0, -gravity_mps2_)};
   send("scan", scan.t_s, anchor.state, scanStatusName(scan.health.status));
   anchor_ = anchor;
   current_ = {anchor.t_s, anchor.state};
@@ -65,6 +82,8 @@ void PoseStream::advance(const ImuSample& s) {
   recent_.push_back(s);
   if (recent_.size() > kMaxRecentSamples) recent_.pop_front();
   if (!anchor_ || s.t_s <= current_.t_s) return;
+  // A stale anchor: the scans held before levelling, released as one burst, or a lidar outage.
+  if (s.t_s - anchor_->t_s > kMaxDeadReckoning_s) return;
   // The reading held from the previous state to this sample (imu/readings.hpp's pieces would
   // average neighbours; at IMU rate a zero-order hold is the live estimate).
   const Eigen::Vector3d a = s.acceleration_imu_mps2 - anchor_->bias.accel_mps2;

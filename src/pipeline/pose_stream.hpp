@@ -1,6 +1,7 @@
 #pragma once
-// live.pose_udp: the body's pose sent as it is known, one JSON object per UDP datagram, for
-// controllers and displays that do not speak WebSocket (docs/live.md, "Pose stream"):
+// The body's pose sent as it is known: to live.pose_udp, one JSON object per UDP datagram, for
+// controllers and displays that do not speak WebSocket (docs/live.md, "Pose stream"), and to the
+// Foxglove server's /taiga/pose and /taiga/imu_pose channels (foxglove_stream.hpp):
 //   {"type":"scan","t_s":...,"frame":"map","p":[x,y,z],"q":[qx,qy,qz,qw],"v":[vx,vy,vz],
 //    "status":"ok"}                                 each scan's pose, T_map_body at the scan's end
 //   {"type":"imu","t_s":...,"frame":"map","p":[...],"q":[...],"v":[...]}
@@ -20,14 +21,17 @@
 #include "taiga/imu/propagation.hpp"
 #include "taiga/io/udp_socket.hpp"
 #include "taiga/pipeline/slam_system.hpp"
+#include "taiga/stream/foxglove_server.hpp"
 
 namespace taiga::pipeline {
 
 class PoseStream final : public SlamObserver {
  public:
-  /// `address` "host:port"; InputError naming live.pose_udp when it is not one.
+  /// `udp_address` "host:port" (empty: no datagrams; InputError naming live.pose_udp when it is
+  /// not one); `foxglove`: the server to publish on too, or null.
   /// `imu_from_system`: IMU samples arrive through onImu (else through imuArrived).
-  PoseStream(const std::string& address, const SystemConfig& config, bool imu_from_system);
+  PoseStream(const std::string& udp_address, stream::FoxgloveServer* foxglove,
+             const SystemConfig& config, bool imu_from_system);
 
   void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
   void onImu(const ImuSample& sample) override;
@@ -41,7 +45,8 @@ class PoseStream final : public SlamObserver {
   /// Carries the dead-reckoned state forward to `sample` and sends it; with the lock held.
   void advance(const ImuSample& sample_body);
 
-  io::UdpSocket socket_;
+  std::optional<io::UdpSocket> socket_;
+  stream::FoxgloveServer* foxglove_;
   const bool imu_from_system_;
   const lie::SO3 R_body_imu_;
   const double gravity_mps2_;

@@ -10,6 +10,7 @@
 #include <set>
 #include <vector>
 
+#include "foxglove_stream.hpp"
 #include "online_trees.hpp"
 #include "pose_stream.hpp"
 #include "recording_feed.hpp"
@@ -196,9 +197,8 @@ bool calibratesAtStart(const SystemConfig& config) {
 /// The SLAM system over `recording` (from `recording_path`, or a live sensor's streams when
 /// `live` is given), its outputs written into options.out_dir.
 RunSummary runRecording(io::Recording& recording, const std::filesystem::path& recording_path,
-                        const SystemConfig& config,
-                        std::optional<CalibrationRunReport> calibration, const RunOptions& options,
-                        io::ouster::LiveCapture* live) {
+                        const SystemConfig& config, std::optional<CalibrationRunReport> calibration,
+                        const RunOptions& options, io::ouster::LiveCapture* live) {
   const std::filesystem::path& out = options.out_dir;
   std::deque<io::RecordingEvent> read_ahead;
   SlamSystem slam(config,
@@ -213,9 +213,16 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   slam.addObserver(scan_log);
   slam.addObserver(health);
   slam.addObserver(gnss);
+  std::unique_ptr<stream::FoxgloveServer> foxglove;
+  std::optional<FoxgloveMapStream> foxglove_map;
+  if (!config.live.foxglove.empty()) {
+    foxglove = startFoxglove(config.live.foxglove);
+    slam.addObserver(foxglove_map.emplace(*foxglove));
+  }
   std::optional<PoseStream> pose_stream;
-  if (!config.live.pose_udp.empty()) {
-    slam.addObserver(pose_stream.emplace(config.live.pose_udp, config, live == nullptr));
+  if (!config.live.pose_udp.empty() || foxglove) {
+    slam.addObserver(
+        pose_stream.emplace(config.live.pose_udp, foxglove.get(), config, live == nullptr));
     if (live != nullptr)
       live->setImuTap([&pose_stream](const ImuSample& sample) { pose_stream->imuArrived(sample); });
   }
@@ -325,8 +332,9 @@ RunSummary runLive(const SystemConfig& config, const RunOptions& options) {
   std::optional<CalibrationRunReport> calibration;
   if (calibratesAtStart(config))  // a live sensor gives no stretch to read ahead
     calibration = CalibrationRunReport{
-        .skipped = "not on a live sensor: calibrate a recording of the rig with taiga calibrate "
-                   "and give the run its rig.yaml"};
+        .skipped =
+            "not on a live sensor: calibrate a recording of the rig with taiga calibrate "
+            "and give the run its rig.yaml"};
   io::Recording recording = capture.recording(config.rig.lidar_time_offset_s);
   return runRecording(recording, capture.name(), config, calibration, options, &capture);
 }

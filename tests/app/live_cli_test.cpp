@@ -6,24 +6,23 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
-
-#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Core>
+#include <atomic>
 #include <chrono>
 #include <fstream>
-#include <atomic>
 #include <future>
-#include <map>
-#include <sstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <thread>
 
 #include "../support/run_taiga.hpp"
-#include "taiga/io/udp_socket.hpp"
 #include "../support/temp_dir.hpp"
+#include "taiga/io/udp_socket.hpp"
 
 namespace taiga::app {
 namespace {
@@ -170,6 +169,58 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
   EXPECT_EQ(scans, online.size());
   EXPECT_GT(imu, 200u);  // 200 Hz over the 1.4 s after the odom frame is levelled
   EXPECT_GT(imu_near, imu * 9 / 10);
+}
+
+// Foxglove's own protocol client (tools/foxglove-check, @foxglove/ws-protocol from npm) connects
+// to a live run and receives the poses, the IMU-rate poses, the keyframes and the scan health.
+TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
+  test::TempDir dir;
+  const auto sim = simulate(dir);
+  const int ws_port = 7505 + portOffset();
+  YAML::Node config = YAML::LoadFile(liveConfig(sim, 1.5).string());
+  config["live"]["foxglove"] = fmt::format("127.0.0.1:{}", ws_port);
+  config["live"]["pose_udp"] = "";
+  const auto config_path = dir.write("foxglove.yaml", YAML::Dump(config) + "\n");
+  auto client = std::async(std::launch::async, [&] {
+    return test::runCommand(fmt::format(
+        "node tools/foxglove-check/foxglove-check.mjs ws://127.0.0.1:{} 60 2>&1", ws_port));
+  });
+  const auto out = sim / "foxglove_run";
+  auto live = startLive(config_path, out);
+  ASSERT_EQ(test::runTaiga(fmt::format("replay {} --rate 2 --port-offset {}",
+                                       (sim / "capture.pcap").string(), portOffset()))
+                .exit_code,
+            0);
+  const test::TaigaResult run = live.get();
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const test::TaigaResult received = client.get();
+  ASSERT_EQ(received.exit_code, 0) << received.output << " (run scripts/setup.sh)";
+  const nlohmann::json j = nlohmann::json::parse(received.output);
+  EXPECT_EQ(j["reason"], "closed by the server");
+  const nlohmann::json& topics = j["topics"];
+  ASSERT_TRUE(topics.contains("/taiga/pose")) << received.output.substr(0, 500);
+  EXPECT_EQ(topics["/taiga/pose"]["schemaName"], "foxglove.PoseInFrame");
+  EXPECT_EQ(topics["/taiga/keyframes"]["schemaName"], "foxglove.PointCloud");
+
+  // The client connected before the first scan: every published pose, as in trajectory_online.
+  const auto online = tumPositions(out / "trajectory_online.tum");
+  const nlohmann::json& poses = topics["/taiga/pose"]["messages"];
+  EXPECT_EQ(poses.size(), online.size());
+  for (const nlohmann::json& m : poses) {
+    const double t_s =
+        m["timestamp"]["sec"].get<double>() + 1e-9 * m["timestamp"]["nsec"].get<double>();
+    const auto it = online.find(std::llround(t_s * 1e4));
+    ASSERT_NE(it, online.end()) << m.dump();
+    const nlohmann::json& p = m["pose"]["position"];
+    EXPECT_LT((it->second - Eigen::Vector3d(p["x"], p["y"], p["z"])).norm(), 1e-6);
+  }
+  EXPECT_GT(topics["/taiga/imu_pose"]["messages"].size(), 200u);
+  const nlohmann::json& keyframes = topics["/taiga/keyframes"]["messages"];
+  EXPECT_GE(keyframes.size(), 3u);
+  for (const nlohmann::json& k : keyframes) EXPECT_GT(k["points"].get<double>(), 1000.0);
+  const nlohmann::json& health = topics["/taiga/health"]["messages"];
+  EXPECT_EQ(health.size(), online.size());
+  for (const nlohmann::json& h : health) EXPECT_EQ(h["status"], "ok");
 }
 
 TEST(LiveCli, SigtermEndsALiveRunWithItsOutputsWritten) {

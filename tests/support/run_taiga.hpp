@@ -15,11 +15,8 @@ struct TaigaResult {
   std::string output;  ///< standard output, and standard error unless dropped
 };
 
-/// `taiga ARGUMENTS`, with `environment` (e.g. "MPLBACKEND=Agg") set for it.
-inline TaigaResult runTaiga(const std::string& arguments, bool keep_stderr = true,
-                            const std::string& environment = "") {
-  const std::string command = environment + " " + std::string(TAIGA_EXECUTABLE) + " " +
-                              arguments + (keep_stderr ? " 2>&1" : " 2>/dev/null");
+/// A shell command's exit code and standard output.
+inline TaigaResult runCommand(const std::string& command) {
   TaigaResult result;
   std::FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
@@ -28,6 +25,13 @@ inline TaigaResult runTaiga(const std::string& arguments, bool keep_stderr = tru
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+/// `taiga ARGUMENTS`, with `environment` (e.g. "MPLBACKEND=Agg") set for it.
+inline TaigaResult runTaiga(const std::string& arguments, bool keep_stderr = true,
+                            const std::string& environment = "") {
+  return runCommand(environment + " " + std::string(TAIGA_EXECUTABLE) + " " + arguments +
+                    (keep_stderr ? " 2>&1" : " 2>/dev/null"));
 }
 
 }  // namespace taiga::test

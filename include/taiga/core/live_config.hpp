@@ -29,6 +29,9 @@ struct LiveConfig final : ConfigSection {
   /// "host:port": every scan's and IMU sample's pose as a JSON datagram (docs/live.md, "Pose
   /// stream"), on a live run and on a recording alike; empty: none.
   std::string pose_udp;
+  /// "host:port" of a Foxglove WebSocket server showing the run (poses, keyframes, health;
+  /// docs/live.md, "Foxglove"), e.g. 0.0.0.0:8765; empty: none.
+  std::string foxglove;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

@@ -1,0 +1,57 @@
+#pragma once
+// A WebSocket server speaking the Foxglove WebSocket protocol v1 (subprotocol
+// foxglove.websocket.v1; github.com/foxglove/ws-protocol, docs/spec.md), so that Foxglove and any
+// client of the protocol can watch a run: channels of JSON messages, advertised when a client
+// connects, sent to the clients that subscribed. Built on websocketpp and standalone asio
+// (Debian packages), on a thread of its own; publish() may be called from any thread.
+//
+// Only what a data source needs is implemented: serverInfo, advertise, subscribe, unsubscribe
+// and Message Data (binary opcode 1: u32 subscription id, u64 timestamp ns, payload). A client
+// that falls behind by more than max_buffered_bytes gets nothing new until it catches up (the
+// messages in between are dropped for it, and counted).
+//
+// This header is C++17 (its implementation must be compiled as C++17 for websocketpp 0.8).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace taiga::stream {
+
+struct FoxgloveChannel {
+  std::string topic;        ///< e.g. "/taiga/pose"
+  std::string schema_name;  ///< e.g. "foxglove.PoseInFrame"
+  std::string schema;       ///< its JSON Schema, as text
+};
+
+struct FoxgloveServerStats {
+  std::uint64_t connections = 0;       ///< clients that connected over the server's life
+  std::uint64_t messages_sent = 0;     ///< Message Data frames sent
+  std::uint64_t messages_dropped = 0;  ///< not sent to a client that was too far behind
+};
+
+class FoxgloveServer {
+ public:
+  /// Listens on `address`:`port` (port 0: any free one, see port()). InputError naming the
+  /// address when it cannot.
+  FoxgloveServer(const std::string& address, std::uint16_t port,
+                 std::vector<FoxgloveChannel> channels, std::string name = "taiga",
+                 std::size_t max_buffered_bytes = 64u << 20);
+  ~FoxgloveServer();
+  FoxgloveServer(const FoxgloveServer&) = delete;
+  FoxgloveServer& operator=(const FoxgloveServer&) = delete;
+
+  std::uint16_t port() const;
+  /// Sends `json` on channel `channel` (index into the channels given) to its subscribers.
+  void publish(std::size_t channel, std::uint64_t t_ns, const std::string& json);
+  /// Whether any client subscribed to `channel` (to skip building messages nobody wants).
+  bool subscribed(std::size_t channel) const;
+  FoxgloveServerStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace taiga::stream
