@@ -190,6 +190,26 @@ std::uint64_t exportMaps(const mapping::KeyframeStore& store, const mapping::Map
   return mapping::exportMap(store, graph.poses(), out / "map.las", attached_options).points_written;
 }
 
+/// A live run that got no usable lidar packet says which of the setup's parts is wrong.
+void throwIfNoLidarData(const io::ouster::LiveStats& live, const std::string& source,
+                        const LiveConfig& config) {
+  if (live.lidar_packets == 0 && live.other_datagrams > 0)
+    throw InputError(fmt::format(
+        "{}: {} datagrams arrived, none of the lidar packet size of {}: the metadata does not "
+        "describe this sensor's configuration (profile, columns per packet, beams)",
+        source, live.other_datagrams, config.metadata));
+  if (live.lidar_packets == 0)
+    throw InputError(fmt::format(
+        "{}: no lidar packet arrived ({} IMU packets; {}): is the sensor sending to this host "
+        "(its udp_dest) and to these ports (live.lidar_port, live.imu_port)?",
+        source, live.imu_packets, live.stop_reason));
+  if (live.bad_packets == live.lidar_packets)
+    throw InputError(fmt::format(
+        "{}: every one of the {} lidar packets was refused (CRC, packet type, or another "
+        "sensor's serial number than {} names; the first warning above says which)",
+        source, live.lidar_packets, config.metadata));
+}
+
 bool calibratesAtStart(const SystemConfig& config) {
   return config.calibration.at_start && config.odometry.imu_use != "lidar_only";
 }
@@ -249,13 +269,7 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     if (r.attempt.accepted && (reattached.empty() || reattached.back().segment != r.segment))
       reattached.push_back(  // the first link of each segment
           {r.segment, r.t_s, r.attempt.correction_m, r.attempt.correction_deg, r.attempt.overlap});
-  if (live != nullptr && summary.live->lidar_packets == 0)
-    throw InputError(fmt::format(
-        "{}: no lidar packet arrived ({} IMU packets, {} other datagrams; {}): is the sensor "
-        "sending to this host (its udp_dest) and to these ports (live.lidar_port, "
-        "live.imu_port)?",
-        recording_path.string(), summary.live->imu_packets, summary.live->other_datagrams,
-        summary.live->stop_reason));
+  if (live != nullptr) throwIfNoLidarData(*summary.live, recording_path.string(), config.live);
   if (trajectories.odometry().empty())
     throw InputError(fmt::format(
         "{}: no scan could be processed ({} scans, {} IMU samples): the odometry needs at least "

@@ -223,6 +223,34 @@ TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
   for (const nlohmann::json& h : health) EXPECT_EQ(h["status"], "ok");
 }
 
+// The packets of one sensor configuration, and metadata that describes another profile or
+// another sensor: the run ends with exit 2 and says which.
+TEST(LiveCli, MetadataOfAnotherProfileOrSensorIsNamed) {
+  test::TempDir dir;
+  const auto sim = simulate(dir);
+  const nlohmann::json metadata = nlohmann::json::parse(readText(sim / "capture.json"));
+  nlohmann::json other_profile = metadata, other_sensor = metadata;
+  other_profile["lidar_data_format"]["udp_profile_lidar"] = "LEGACY";
+  other_profile["config_params"]["udp_profile_lidar"] = "LEGACY";
+  other_sensor["sensor_info"]["prod_sn"] = "990000999999";
+  for (const auto& [variant, expected] :
+       {std::pair{other_profile, "none of the lidar packet size"},
+        std::pair{other_sensor, "every one of the"}}) {
+    SCOPED_TRACE(expected);
+    YAML::Node config = YAML::LoadFile(liveConfig(sim, 1.0).string());
+    config["live"]["metadata"] = dir.write("variant.json", variant.dump()).string();
+    const auto config_path = dir.write("variant.yaml", YAML::Dump(config) + "\n");
+    auto live = startLive(config_path, dir.file("variant_run"));
+    ASSERT_EQ(test::runTaiga(fmt::format("replay {} --rate 4 --port-offset {}",
+                                         (sim / "capture.pcap").string(), portOffset()))
+                  .exit_code,
+              0);
+    const test::TaigaResult r = live.get();
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(expected));
+  }
+}
+
 TEST(LiveCli, SigtermEndsALiveRunWithItsOutputsWritten) {
   test::TempDir dir;
   const auto sim = simulate(dir);
