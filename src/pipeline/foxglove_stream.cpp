@@ -12,8 +12,8 @@
 namespace taiga::pipeline {
 namespace {
 
-/// Points per keyframe message at most: a keyframe's scan thinned evenly to this many.
-constexpr std::size_t kMaxKeyframePoints = 30000;
+/// Points per cloud message at most: a keyframe's scan is thinned evenly to this many.
+constexpr std::size_t kMaxCloudPoints = 30000;
 constexpr int kFloat32 = 7;  // foxglove.NumericType
 
 std::uint64_t nanoseconds(double t_s) {
@@ -57,43 +57,10 @@ const char* kPointCloudSchema =
 const char* kHealthSchema =
     R"({"type":"object","properties":{"t_s":{"type":"number"},"status":{"type":"string"},"reason":{"type":"string"},"processing_ms":{"type":"number"},"points":{"type":"integer"}}})";
 
-}  // namespace
-
-std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_port) {
-  const auto address = udpAddressPort(host_port);
-  if (!address)
-    throw InputError(fmt::format("live.foxglove: expected host:port, found '{}'", host_port));
-  return std::make_unique<stream::FoxgloveServer>(
-      address->first, address->second,
-      std::vector<stream::FoxgloveChannel>{
-          {"/taiga/pose", "foxglove.PoseInFrame", kPoseInFrameSchema},
-          {"/taiga/imu_pose", "foxglove.PoseInFrame", kPoseInFrameSchema},
-          {"/taiga/keyframes", "foxglove.PointCloud", kPointCloudSchema},
-          {"/taiga/health", "taiga.ScanHealth", kHealthSchema}});
-}
-
-std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body) {
-  return nlohmann::json{
-      {"timestamp", timestamp(t_s)}, {"frame_id", "map"}, {"pose", pose(T_map_body)}}
-      .dump();
-}
-
-void FoxgloveMapStream::onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) {
-  T_map_odom_ = T_map_odom;
-  if (!server_.subscribed(kHealthTopic)) return;
-  server_.publish(kHealthTopic, nanoseconds(scan.t_s),
-                  nlohmann::json{{"t_s", scan.t_s},
-                                 {"status", scanStatusName(scan.health.status)},
-                                 {"reason", scan.health.reason},
-                                 {"processing_ms", scan.timing.total_ms},
-                                 {"points", scan.source_points}}
-                      .dump());
-}
-
-void FoxgloveMapStream::onKeyframe(std::uint64_t /*id*/, const ScanOutcome& scan) {
-  if (!scan.keyframe_cloud_in_body || !server_.subscribed(kKeyframesTopic)) return;
-  const PointCloud& cloud = *scan.keyframe_cloud_in_body;
-  const std::size_t step = cloud.size() / kMaxKeyframePoints + 1;
+/// A foxglove.PointCloud of `cloud` (body frame) placed at T_map_body, thinned evenly to at
+/// most kMaxCloudPoints: x, y, z, intensity as float32.
+std::string pointCloudJson(double t_s, const lie::SE3& T_map_body, const PointCloud& cloud) {
+  const std::size_t step = cloud.size() / kMaxCloudPoints + 1;
   std::vector<unsigned char> data;
   data.reserve(cloud.size() / step * 16);
   for (std::size_t i = 0; i < cloud.size(); i += step) {
@@ -107,14 +74,55 @@ void FoxgloveMapStream::onKeyframe(std::uint64_t /*id*/, const ScanOutcome& scan
   nlohmann::json fields = nlohmann::json::array();
   for (const auto& [name, offset] : {std::pair{"x", 0}, {"y", 4}, {"z", 8}, {"intensity", 12}})
     fields.push_back({{"name", name}, {"offset", offset}, {"type", kFloat32}});
-  server_.publish(kKeyframesTopic, nanoseconds(scan.t_s),
-                  nlohmann::json{{"timestamp", timestamp(scan.t_s)},
-                                 {"frame_id", "map"},
-                                 {"pose", pose(T_map_odom_ * scan.T_odom_body)},
-                                 {"point_stride", 16},
-                                 {"fields", fields},
-                                 {"data", base64(data)}}
+  return nlohmann::json{
+      {"timestamp", timestamp(t_s)}, {"frame_id", "map"}, {"pose", pose(T_map_body)},
+      {"point_stride", 16},          {"fields", fields},  {"data", base64(data)}}
+      .dump();
+}
+
+}  // namespace
+
+std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_port) {
+  const auto address = udpAddressPort(host_port);
+  if (!address)
+    throw InputError(fmt::format("live.foxglove: expected host:port, found '{}'", host_port));
+  return std::make_unique<stream::FoxgloveServer>(
+      address->first, address->second,
+      std::vector<stream::FoxgloveChannel>{
+          {"/taiga/pose", "foxglove.PoseInFrame", kPoseInFrameSchema},
+          {"/taiga/imu_pose", "foxglove.PoseInFrame", kPoseInFrameSchema},
+          {"/taiga/scan", "foxglove.PointCloud", kPointCloudSchema},
+          {"/taiga/keyframes", "foxglove.PointCloud", kPointCloudSchema},
+          {"/taiga/health", "taiga.ScanHealth", kHealthSchema}});
+}
+
+std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body) {
+  return nlohmann::json{
+      {"timestamp", timestamp(t_s)}, {"frame_id", "map"}, {"pose", pose(T_map_body)}}
+      .dump();
+}
+
+void FoxgloveMapStream::onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) {
+  T_map_odom_ = T_map_odom;
+  if (scan.source_cloud_in_body && server_.subscribed(kScanTopic))
+    server_.publish(
+        kScanTopic, nanoseconds(scan.t_s),
+        pointCloudJson(scan.t_s, T_map_odom * scan.T_odom_body, *scan.source_cloud_in_body));
+  if (!server_.subscribed(kHealthTopic)) return;
+  server_.publish(kHealthTopic, nanoseconds(scan.t_s),
+                  nlohmann::json{{"t_s", scan.t_s},
+                                 {"status", scanStatusName(scan.health.status)},
+                                 {"reason", scan.health.reason},
+                                 {"processing_ms", scan.timing.total_ms},
+                                 {"points", scan.source_points}}
                       .dump());
+}
+
+void FoxgloveMapStream::onKeyframe(std::uint64_t /*id*/, const ScanOutcome& scan) {
+  if (!scan.keyframe_cloud_in_body || !server_.subscribed(kKeyframesTopic)) return;
+  server_.publish(
+      kKeyframesTopic, nanoseconds(scan.t_s),
+      pointCloudJson(scan.t_s, T_map_odom_ * scan.T_odom_body, *scan.keyframe_cloud_in_body));
 }
 
 }  // namespace taiga::pipeline

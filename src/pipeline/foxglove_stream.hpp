@@ -3,6 +3,8 @@
 // docs/live.md, "Foxglove"). Channels, every message JSON in the map frame:
 //   /taiga/pose       foxglove.PoseInFrame   each scan's pose as published (PoseStream)
 //   /taiga/imu_pose   foxglove.PoseInFrame   the IMU-rate dead-reckoned pose (PoseStream)
+//   /taiga/scan       foxglove.PointCloud    each scan as registered (deskewed, voxel-filtered)
+//                                            at its pose as published
 //   /taiga/keyframes  foxglove.PointCloud    each keyframe's scan, thinned, placed at its pose as
 //                                            published: the growing map, one message per keyframe
 //   /taiga/health     taiga.ScanHealth       each scan's status, reason and processing time
@@ -17,7 +19,13 @@
 
 namespace taiga::pipeline {
 
-enum FoxgloveTopic : std::size_t { kPoseTopic, kImuPoseTopic, kKeyframesTopic, kHealthTopic };
+enum FoxgloveTopic : std::size_t {
+  kPoseTopic,
+  kImuPoseTopic,
+  kScanTopic,
+  kKeyframesTopic,
+  kHealthTopic
+};
 
 /// The server with the channels above, on "host:port"; InputError naming live.foxglove when the
 /// address is not one or cannot be served.

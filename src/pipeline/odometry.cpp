@@ -127,9 +127,9 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
 
   // 3. Voxel filter.
   auto stage = Clock::now();
-  const PointCloud source_cloud =
-      preprocess::voxelFilter(cloud_in_body, config_.voxel_size_m,
-                              preprocess::voxelRepresentative(config_.voxel_point));
+  outcome.source_cloud_in_body = std::make_shared<const PointCloud>(preprocess::voxelFilter(
+      cloud_in_body, config_.voxel_size_m, preprocess::voxelRepresentative(config_.voxel_point)));
+  const PointCloud& source_cloud = *outcome.source_cloud_in_body;
   outcome.source_points = source_cloud.size();
   outcome.timing.filter_ms = msSince(stage);
 

@@ -215,6 +215,9 @@ TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
     EXPECT_LT((it->second - Eigen::Vector3d(p["x"], p["y"], p["z"])).norm(), 1e-6);
   }
   EXPECT_GT(topics["/taiga/imu_pose"]["messages"].size(), 200u);
+  const nlohmann::json& scans = topics["/taiga/scan"]["messages"];
+  EXPECT_EQ(scans.size() + 1, online.size());  // every scan registered: all but the first
+  for (const nlohmann::json& s : scans) EXPECT_GT(s["points"].get<double>(), 500.0);
   const nlohmann::json& keyframes = topics["/taiga/keyframes"]["messages"];
   EXPECT_GE(keyframes.size(), 3u);
   for (const nlohmann::json& k : keyframes) EXPECT_GT(k["points"].get<double>(), 1000.0);
@@ -233,9 +236,8 @@ TEST(LiveCli, MetadataOfAnotherProfileOrSensorIsNamed) {
   other_profile["lidar_data_format"]["udp_profile_lidar"] = "LEGACY";
   other_profile["config_params"]["udp_profile_lidar"] = "LEGACY";
   other_sensor["sensor_info"]["prod_sn"] = "990000999999";
-  for (const auto& [variant, expected] :
-       {std::pair{other_profile, "none of the lidar packet size"},
-        std::pair{other_sensor, "every one of the"}}) {
+  for (const auto& [variant, expected] : {std::pair{other_profile, "none of the lidar packet size"},
+                                          std::pair{other_sensor, "every one of the"}}) {
     SCOPED_TRACE(expected);
     YAML::Node config = YAML::LoadFile(liveConfig(sim, 1.0).string());
     config["live"]["metadata"] = dir.write("variant.json", variant.dump()).string();

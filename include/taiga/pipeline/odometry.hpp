@@ -84,6 +84,9 @@ struct ScanOutcome {
   /// The longest stretch without IMU readings from the previous state to the scan's end, s.
   double imu_gap_s = 0.0;
   std::size_t source_points = 0;
+  /// The registration's source: the deskewed scan in the body frame at t_s, voxel-filtered
+  /// (what a viewer shows as the current scan).
+  std::shared_ptr<const PointCloud> source_cloud_in_body;
   ScanHealth health;
   /// The local map segment the scan belongs to: 0, and one more each time the odometry gave up
   /// a lost local map and started a new one.
