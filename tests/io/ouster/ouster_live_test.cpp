@@ -7,7 +7,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <fstream>
 #include <thread>
 
 #include "../../support/temp_dir.hpp"
@@ -81,12 +80,9 @@ Received drain(Recording& recording) {
 TEST(OusterLive, PacketsFromTheSocketsBecomeScansAndSamplesAndLossesAreCounted) {
   test::TempDir dir;
   const SensorInfo info = sensor();
-  {
-    std::ofstream json(dir.file("sensor.json"));
-    json << sensorInfoJson(info);
-  }
+  const auto metadata = dir.write("sensor.json", sensorInfoJson(info));
   LiveCapture capture(
-      {.metadata = dir.file("sensor.json"), .bind_address = "127.0.0.1", .idle_timeout_s = 0.5});
+      {.metadata = metadata, .bind_address = "127.0.0.1", .idle_timeout_s = 0.5});
   Recording recording = capture.recording(0.0);
   std::thread sender([&] {
     UdpSocket lidar = UdpSocket::connected("127.0.0.1", info.udp_port_lidar);
@@ -129,13 +125,10 @@ TEST(OusterLive, PacketsFromTheSocketsBecomeScansAndSamplesAndLossesAreCounted) 
 TEST(OusterLive, APortInUseIsNamed) {
   test::TempDir dir;
   const SensorInfo info = sensor();
-  {
-    std::ofstream json(dir.file("sensor.json"));
-    json << sensorInfoJson(info);
-  }
+  const auto metadata = dir.write("sensor.json", sensorInfoJson(info));
   const UdpSocket taken = UdpSocket::bound("127.0.0.1", testPort(2));
   try {
-    LiveCapture capture({.metadata = dir.file("sensor.json"),
+    LiveCapture capture({.metadata = metadata,
                          .bind_address = "127.0.0.1",
                          .lidar_port = testPort(2)});
     FAIL() << "bound a port in use";
@@ -150,12 +143,9 @@ TEST(OusterLive, APortInUseIsNamed) {
 TEST(OusterLive, AStopRequestEndsTheStreams) {
   test::TempDir dir;
   const SensorInfo info = sensor();
-  {
-    std::ofstream json(dir.file("sensor.json"));
-    json << sensorInfoJson(info);
-  }
+  const auto metadata = dir.write("sensor.json", sensorInfoJson(info));
   LiveCapture capture(
-      {.metadata = dir.file("sensor.json"), .bind_address = "127.0.0.1", .idle_timeout_s = 0.0});
+      {.metadata = metadata, .bind_address = "127.0.0.1", .idle_timeout_s = 0.0});
   Recording recording = capture.recording(0.0);
   std::thread stopper([] {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
