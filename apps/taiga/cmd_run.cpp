@@ -131,9 +131,9 @@ int run(const RunOptions& options) {
     std::signal(SIGINT, stopLiveOnSignal);
     std::signal(SIGTERM, stopLiveOnSignal);
   }
-  const pipeline::RunSummary s = options.live
-                                     ? pipeline::runLive(config, run_options)
-                                     : pipeline::runOdometry(options.recording, config, run_options);
+  const pipeline::RunSummary s =
+      options.live ? pipeline::runLive(config, run_options)
+                   : pipeline::runOdometry(options.recording, config, run_options);
   if (s.calibration) printCalibration(*s.calibration);
   fmt::print("scans      {} read, {} processed; {} IMU samples; {:.1f} s, {:.1f} m of path\n",
              s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
@@ -152,6 +152,12 @@ int run(const RunOptions& options) {
         "trees      {} stems in trees.csv (the live list's worker busy {:.1f} s during the "
         "run; the final inventory {:.1f} s after it)\n",
         *s.trees, s.trees_work_s, s.trees_final_s);
+  if (s.streams)
+    fmt::print(
+        "streams    {} poses sent; Foxglove: {} clients, {} messages ({} dropped for a client too "
+        "far behind)\n",
+        s.streams->poses_sent, s.streams->foxglove_clients, s.streams->foxglove_messages,
+        s.streams->foxglove_dropped);
   if (s.live) {
     printLive(*s.live, *s.realtime);
   } else if (s.realtime) {

@@ -15,8 +15,8 @@ namespace {
 /// processing, at any IMU rate.
 constexpr std::size_t kMaxRecentSamples = 2000;
 /// IMU-rate poses further than this from the latest scan pose are not sent: dead reckoning
-/// drifts by metres in seconds.
-constexpr double kMaxDeadReckoning_s = 1.0;
+/// drifts by centimetres in half a second (13 cm in 1 s on a handheld walk), metres in seconds.
+constexpr double kMaxDeadReckoning_s = 0.5;
 
 io::UdpSocket openSocket(const std::string& address) {
   const auto host_port = udpAddressPort(address);
@@ -51,6 +51,7 @@ void PoseStream::send(const char* type, double t_s, const imu::NavState& s, cons
       type, t_s, s.p_world.x(), s.p_world.y(), s.p_world.z(), q.x(), q.y(), q.z(), q.w(),
       s.v_world.x(), s.v_world.y(), s.v_world.z());
   if (status != nullptr) text += fmt::format(R"(,"status":"{}")", status);
+  if (status == nullptr) text += fmt::format(R"(,"age_s":{:.3f})", t_s - anchor_->t_s);
   text += "}\n";
   socket_->send(std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }

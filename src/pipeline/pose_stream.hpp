@@ -4,9 +4,10 @@
 // Foxglove server's /taiga/pose and /taiga/imu_pose channels (foxglove_stream.hpp):
 //   {"type":"scan","t_s":...,"frame":"map","p":[x,y,z],"q":[qx,qy,qz,qw],"v":[vx,vy,vz],
 //    "status":"ok"}                                 each scan's pose, T_map_body at the scan's end
-//   {"type":"imu","t_s":...,"frame":"map","p":[...],"q":[...],"v":[...]}
+//   {"type":"imu","t_s":...,"frame":"map","p":[...],"q":[...],"v":[...],"age_s":0.035}
 //                                                   each IMU sample's pose, dead-reckoned from
 //                                                   the latest scan pose (imu/propagation.hpp)
+//                                                   age_s ago, at most 0.5 s
 // IMU samples come either through the SLAM system (onImu, in time order: a recording) or, on a
 // live sensor, straight from the receiver as packets arrive (imuArrived, another thread), so
 // that an IMU-rate pose leaves a few milliseconds after its packet instead of after the scan it

@@ -259,6 +259,13 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     live->setImuTap(nullptr);  // before pose_stream goes
     summary.live = live->stats();
   }
+  if (pose_stream) summary.streams = RunSummary::Streams{.poses_sent = pose_stream->sent()};
+  if (foxglove) {
+    const stream::FoxgloveServerStats f = foxglove->stats();
+    summary.streams->foxglove_clients = f.connections;
+    summary.streams->foxglove_messages = f.messages_sent;
+    summary.streams->foxglove_dropped = f.messages_dropped;
+  }
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);

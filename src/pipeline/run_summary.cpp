@@ -145,13 +145,22 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
                        {"p99", s.realtime->latency_p99_ms},
                        {"max", s.realtime->latency_max_ms}}}};
   }
+  if (s.streams)
+    j["streams"] = {{"poses_sent", s.streams->poses_sent},
+                    {"foxglove_clients", s.streams->foxglove_clients},
+                    {"foxglove_messages", s.streams->foxglove_messages},
+                    {"foxglove_dropped", s.streams->foxglove_dropped}};
   if (s.live) {
     const io::ouster::LiveStats& l = *s.live;
-    j["live"] = {{"lidar_packets", l.lidar_packets},   {"imu_packets", l.imu_packets},
-                 {"other_datagrams", l.other_datagrams}, {"kernel_drops", l.kernel_drops},
-                 {"bad_packets", l.bad_packets},       {"frames", l.frames},
+    j["live"] = {{"lidar_packets", l.lidar_packets},
+                 {"imu_packets", l.imu_packets},
+                 {"other_datagrams", l.other_datagrams},
+                 {"kernel_drops", l.kernel_drops},
+                 {"bad_packets", l.bad_packets},
+                 {"frames", l.frames},
                  {"incomplete_frames", l.incomplete_frames},
-                 {"missing_columns", l.missing_columns}, {"max_backlog", l.max_backlog},
+                 {"missing_columns", l.missing_columns},
+                 {"max_backlog", l.max_backlog},
                  {"stop_reason", l.stop_reason}};
   }
   if (s.georef) {

@@ -127,9 +127,9 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
 
   const auto live_run = sim / "live_run";
   PoseReceiver pose_receiver;
-  auto live = startLive(liveConfig(sim, 1.5), live_run);
+  auto live = startLive(liveConfig(sim, 3.0), live_run);
   const test::TaigaResult replay = test::runTaiga(fmt::format(
-      "replay {} --rate 2 --port-offset {}", (sim / "capture.pcap").string(), portOffset()));
+      "replay {} --rate 1 --port-offset {}", (sim / "capture.pcap").string(), portOffset()));
   ASSERT_EQ(replay.exit_code, 0) << replay.output;
   const test::TaigaResult r = live.get();
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -151,7 +151,7 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
   const std::vector<nlohmann::json> poses = pose_receiver.stop();
   const auto online = tumPositions(live_run / "trajectory_online.tum");
   const auto imu_rate = tumPositions(live_run / "trajectory_imu.tum");
-  std::size_t scans = 0, imu = 0, imu_near = 0;
+  std::size_t scans = 0, imu = 0, imu_fresh = 0, imu_fresh_near = 0;
   for (const nlohmann::json& pose : poses) {
     const Eigen::Vector3d p(pose["p"][0], pose["p"][1], pose["p"][2]);
     const long long key = std::llround(pose["t_s"].get<double>() * 1e4);
@@ -163,12 +163,19 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
     } else {
       ++imu;
       const auto it = imu_rate.find(key);
-      if (it != imu_rate.end() && (it->second - p).norm() < 0.05) ++imu_near;
+      if (it == imu_rate.end()) continue;  // after the last scan: not in trajectory_imu.tum
+      EXPECT_LE(pose["age_s"].get<double>(), 0.5);
+      EXPECT_LT((it->second - p).norm(), 0.3) << pose.dump();  // garbage would be metres off
+      if (pose["age_s"].get<double>() > 0.15) continue;
+      ++imu_fresh;  // dead-reckoned less than 1.5 scans: close to the run's IMU-rate pose
+      if ((it->second - p).norm() < 0.05) ++imu_fresh_near;
     }
   }
   EXPECT_EQ(scans, online.size());
-  EXPECT_GT(imu, 200u);  // 200 Hz over the 1.4 s after the odom frame is levelled
-  EXPECT_GT(imu_near, imu * 9 / 10);
+  // At most 200 Hz over the 1.4 s after the odom frame is levelled; fewer on a loaded machine,
+  // where the odometry lags by more than the 1 s that IMU-rate poses are dead-reckoned.
+  EXPECT_GT(imu, 20u);
+  EXPECT_GT(imu_fresh_near, imu_fresh * 9 / 10);
 }
 
 // Foxglove's own protocol client (tools/foxglove-check, @foxglove/ws-protocol from npm) connects
@@ -177,7 +184,7 @@ TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
   test::TempDir dir;
   const auto sim = simulate(dir);
   const int ws_port = 7505 + portOffset();
-  YAML::Node config = YAML::LoadFile(liveConfig(sim, 1.5).string());
+  YAML::Node config = YAML::LoadFile(liveConfig(sim, 3.0).string());
   config["live"]["foxglove"] = fmt::format("127.0.0.1:{}", ws_port);
   config["live"]["pose_udp"] = "";
   const auto config_path = dir.write("foxglove.yaml", YAML::Dump(config) + "\n");
@@ -187,7 +194,7 @@ TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
   });
   const auto out = sim / "foxglove_run";
   auto live = startLive(config_path, out);
-  ASSERT_EQ(test::runTaiga(fmt::format("replay {} --rate 2 --port-offset {}",
+  ASSERT_EQ(test::runTaiga(fmt::format("replay {} --rate 1 --port-offset {}",
                                        (sim / "capture.pcap").string(), portOffset()))
                 .exit_code,
             0);
@@ -214,7 +221,7 @@ TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
     const nlohmann::json& p = m["pose"]["position"];
     EXPECT_LT((it->second - Eigen::Vector3d(p["x"], p["y"], p["z"])).norm(), 1e-6);
   }
-  EXPECT_GT(topics["/taiga/imu_pose"]["messages"].size(), 200u);
+  EXPECT_GT(topics["/taiga/imu_pose"]["messages"].size(), 20u);  // see the test above
   const nlohmann::json& scans = topics["/taiga/scan"]["messages"];
   EXPECT_EQ(scans.size() + 1, online.size());  // every scan registered: all but the first
   for (const nlohmann::json& s : scans) EXPECT_GT(s["points"].get<double>(), 500.0);
@@ -239,7 +246,7 @@ TEST(LiveCli, MetadataOfAnotherProfileOrSensorIsNamed) {
   for (const auto& [variant, expected] : {std::pair{other_profile, "none of the lidar packet size"},
                                           std::pair{other_sensor, "every one of the"}}) {
     SCOPED_TRACE(expected);
-    YAML::Node config = YAML::LoadFile(liveConfig(sim, 1.0).string());
+    YAML::Node config = YAML::LoadFile(liveConfig(sim, 3.0).string());
     config["live"]["metadata"] = dir.write("variant.json", variant.dump()).string();
     const auto config_path = dir.write("variant.yaml", YAML::Dump(config) + "\n");
     auto live = startLive(config_path, dir.file("variant_run"));

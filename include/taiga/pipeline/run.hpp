@@ -160,6 +160,13 @@ struct RunSummary {
   std::optional<GeorefRunReport> georef;            ///< when the recording has GNSS fixes
   std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
   std::optional<io::ouster::LiveStats> live;        ///< taiga run --live: the packets' fate
+  /// live.pose_udp / live.foxglove: poses sent; Foxglove clients and messages (and those dropped
+  /// for a client too far behind).
+  struct Streams {
+    std::size_t poses_sent = 0;
+    std::uint64_t foxglove_clients = 0, foxglove_messages = 0, foxglove_dropped = 0;
+  };
+  std::optional<Streams> streams;
   /// With mapping.trees: the stems in trees.csv, the worker's busy time on the live list during
   /// the run and the final inventory's time after it, s.
   std::optional<std::size_t> trees;

@@ -7,8 +7,8 @@
 #include <condition_variable>
 #include <deque>
 #include <functional>
-#include <optional>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -34,6 +34,7 @@ static_assert(std::atomic<bool>::is_always_lock_free,
 }  // namespace
 
 DatagramKind classifyDatagram(std::size_t bytes, std::size_t lidar_bytes, std::size_t imu_bytes) {
+  if (bytes == 0) return DatagramKind::kOther;  // also when a stream is off (its size 0)
   if (bytes == lidar_bytes) return DatagramKind::kLidar;
   if (bytes == imu_bytes) return DatagramKind::kImu;
   return DatagramKind::kOther;
