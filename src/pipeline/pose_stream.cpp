@@ -71,12 +71,16 @@ void PoseStream::onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) {
   // The samples that arrived after the scan's end are carried forward from the new anchor
   // (without sending again: they were sent from the previous one).
   while (!recent_.empty() && recent_.front().t_s <= anchor.t_s) recent_.pop_front();
-  for (const ImuSample& s : recent_) {
-    const Eigen::Vector3d a = s.acceleration_imu_mps2 - anchor.bias.accel_mps2;
-    const Eigen::Vector3d w = s.angular_velocity_imu_radps - anchor.bias.gyro_radps;
-    current_.state = imu::propagate(current_.state, a, w, s.t_s - current_.t_s, anchor.gravity_map);
-    current_.t_s = s.t_s;
-  }
+  for (const ImuSample& s : recent_) carryTo(s);
+}
+
+void PoseStream::carryTo(const ImuSample& s) {
+  // The reading held from the previous state to this sample (imu/readings.hpp's pieces would
+  // average neighbours; live, the next sample is not there yet).
+  const Eigen::Vector3d a = s.acceleration_imu_mps2 - anchor_->bias.accel_mps2;
+  const Eigen::Vector3d w = s.angular_velocity_imu_radps - anchor_->bias.gyro_radps;
+  current_.state = imu::propagate(current_.state, a, w, s.t_s - current_.t_s, anchor_->gravity_map);
+  current_.t_s = s.t_s;
 }
 
 void PoseStream::advance(const ImuSample& s) {
@@ -85,12 +89,7 @@ void PoseStream::advance(const ImuSample& s) {
   if (!anchor_ || s.t_s <= current_.t_s) return;
   // A stale anchor: the scans held before levelling, released as one burst, or a lidar outage.
   if (s.t_s - anchor_->t_s > kMaxDeadReckoning_s) return;
-  // The reading held from the previous state to this sample (imu/readings.hpp's pieces would
-  // average neighbours; at IMU rate a zero-order hold is the live estimate).
-  const Eigen::Vector3d a = s.acceleration_imu_mps2 - anchor_->bias.accel_mps2;
-  const Eigen::Vector3d w = s.angular_velocity_imu_radps - anchor_->bias.gyro_radps;
-  current_.state = imu::propagate(current_.state, a, w, s.t_s - current_.t_s, anchor_->gravity_map);
-  current_.t_s = s.t_s;
+  carryTo(s);
   send("imu", s.t_s, current_.state, nullptr);
 }
 

@@ -42,9 +42,12 @@ class PoseStream final : public SlamObserver {
   std::size_t sent() const;
 
  private:
+  /// One pose to every output; `status` is the scan's, null for an IMU-rate pose.
   void send(const char* type, double t_s, const imu::NavState& state, const char* status);
   /// Carries the dead-reckoned state forward to `sample` and sends it; with the lock held.
   void advance(const ImuSample& sample_body);
+  /// Dead-reckons the current state to `sample` with the anchor's bias and gravity.
+  void carryTo(const ImuSample& sample_body);
 
   std::optional<io::UdpSocket> socket_;
   stream::FoxgloveServer* foxglove_;
