@@ -101,16 +101,12 @@ void stopLiveOnSignal(int signal) {
   std::signal(signal, SIG_DFL);
 }
 
-void printLive(const io::ouster::LiveStats& l, const pipeline::RealtimeReport& r) {
+void printLive(const io::ouster::LiveStats& l) {
   fmt::print(
       "live       {} lidar and {} IMU packets; {} frames, {} incomplete ({} columns missing: lost "
       "packets), {} bad packets, {} other datagrams, {} dropped by the kernel; ended: {}\n",
       l.lidar_packets, l.imu_packets, l.frames, l.incomplete_frames, l.missing_columns,
       l.bad_packets, l.other_datagrams, l.kernel_drops, l.stop_reason);
-  fmt::print(
-      "           {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p99, {:.1f} "
-      "ms max from a scan's assembly to its pose\n",
-      r.dropped_scans, r.latency_p50_ms, r.latency_p99_ms, r.latency_max_ms);
 }
 
 int run(const RunOptions& options) {
@@ -158,15 +154,13 @@ int run(const RunOptions& options) {
         "far behind)\n",
         s.streams->poses_sent, s.streams->foxglove_clients, s.streams->foxglove_messages,
         s.streams->foxglove_dropped);
-  if (s.live) {
-    printLive(*s.live, *s.realtime);
-  } else if (s.realtime) {
+  if (s.live) printLive(*s.live);
+  if (s.realtime)  // --realtime and --live alike
     fmt::print(
         "realtime   {} scans dropped (odometry behind); latency {:.1f} ms p50, {:.1f} ms p95, "
-        "{:.1f} ms max from delivery to pose\n",
+        "{:.1f} ms p99, {:.1f} ms max from a scan's delivery to its pose\n",
         s.realtime->dropped_scans, s.realtime->latency_p50_ms, s.realtime->latency_p95_ms,
-        s.realtime->latency_max_ms);
-  }
+        s.realtime->latency_p99_ms, s.realtime->latency_max_ms);
   if (s.georef) {
     if (s.georef->skipped.empty()) {
       fmt::print(
