@@ -23,6 +23,7 @@ struct RunOptions {
   bool live = false;
   bool ply = false;
   double map_voxel_m = 0.0;
+  int threads = -1;  // -1: compute.threads
   std::string registration;
   std::string moving_boxes;
 };
@@ -113,6 +114,7 @@ int run(const RunOptions& options) {
   useOneMallocArena();
   SystemConfig config = loadConfig(options.config);
   if (!options.registration.empty()) config.odometry.method = options.registration;
+  if (options.threads >= 0) config.compute.threads = options.threads;
   validateAll(config);
   if (options.live == !options.recording.empty())
     throw InputError("taiga run: give either a RECORDING or --live, not both or neither");
@@ -137,9 +139,9 @@ int run(const RunOptions& options) {
              s.lidar_rejected, s.lidar_inflated, s.keyframes, s.map_points);
   printHealth(s.health);
   fmt::print(
-      "time       {:.1f} ms mean, {:.1f} ms p95, {:.1f} ms max per scan; {}; peak memory {:.0f} "
-      "MB\n",
-      s.mean_ms, s.p95_ms, s.max_ms,
+      "time       {:.1f} ms median, {:.1f} ms p95, {:.1f} ms p99, {:.1f} ms max per scan on {} "
+      "thread{}; {}; peak memory {:.0f} MB\n",
+      s.median_ms, s.p95_ms, s.p99_ms, s.max_ms, s.threads, s.threads == 1 ? "" : "s",
       s.live ? "live" : fmt::format("{:.2f}x real time", s.realtime_factor), s.peak_memory_mb);
   fmt::print("mapping    {} loop closures (loops.csv); map exported in {:.1f} s after the run\n",
              s.loop_closures, s.map_export_s);
@@ -196,6 +198,11 @@ Command addRunCommand(CLI::App& tool) {
                    "Run on a live Ouster sensor's UDP packets (configuration section live:) "
                    "instead of a recording, until Ctrl-C or live.idle_timeout_s without a packet");
   parser->add_flag("--ply", options->ply, "Also write map.ply");
+  parser
+      ->add_option("--threads", options->threads,
+                   "Worker threads of the parallel stages, 0: one per core (overrides "
+                   "compute.threads)")
+      ->check(CLI::Range(0, 1024));
   parser
       ->add_option("--registration", options->registration,
                    "Scan-to-map registration (overrides odometry.method)")

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <sys/resource.h>
+#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -210,6 +211,21 @@ void throwIfNoLidarData(const io::ouster::LiveStats& live, const std::string& so
         source, live.lidar_packets, config.metadata));
 }
 
+/// Caps the worker threads of the parallel stages for as long as it lives (compute.threads).
+/// The pipeline's own threads (reading, building the next local map, the mapping back end) are
+/// not workers: they mostly wait, and docs/architecture.md lists them.
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads) {
+    if (threads > 0)
+      control_.emplace(tbb::global_control::max_allowed_parallelism,
+                       static_cast<std::size_t>(threads));
+  }
+
+ private:
+  std::optional<tbb::global_control> control_;
+};
+
 bool calibratesAtStart(const SystemConfig& config) {
   return config.calibration.at_start && config.odometry.imu_use != "lidar_only";
 }
@@ -311,6 +327,8 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   summary.realtime_factor =
       summary.wall_time_s > 0.0 ? summary.duration_s / summary.wall_time_s : 0.0;
   summary.peak_memory_mb = peakMemoryMb();
+  summary.threads = static_cast<int>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   summary.initialization = slam.odometry().initializationNote();
   summary.calibration = calibration;
   writeSummary(out / "summary.json", summary, recording_path, mapper.gnssReport());
@@ -322,6 +340,7 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
 RunSummary runOdometry(const std::filesystem::path& recording_path, const SystemConfig& configured,
                        const RunOptions& options) {
   createOutputDirectory(options.out_dir);
+  const ThreadLimit thread_limit(configured.compute.threads);
   SystemConfig config = configured;
   std::optional<CalibrationRunReport> calibration;
   if (calibratesAtStart(config)) {
@@ -343,6 +362,7 @@ RunSummary runLive(const SystemConfig& config, const RunOptions& options) {
         "live.metadata: a live run needs the sensor's metadata JSON (beam angles, packet "
         "profiles, ports); set it in the configuration");
   createOutputDirectory(options.out_dir);
+  const ThreadLimit thread_limit(config.compute.threads);
   io::ouster::LiveCapture capture(
       {.metadata = config.live.metadata,
        .bind_address = config.live.bind_address,

@@ -98,6 +98,7 @@ void ScanLog::fillSummary(RunSummary& s) const {
               static_cast<double>(totals_ms_.size());
   s.median_ms = percentile(totals_ms_, 50.0);
   s.p95_ms = percentile(totals_ms_, 95.0);
+  s.p99_ms = percentile(totals_ms_, 99.0);
   s.max_ms = *std::max_element(totals_ms_.begin(), totals_ms_.end());
 }
 

@@ -119,11 +119,15 @@ std::future<test::TaigaResult> startLive(const std::filesystem::path& config,
 TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
   test::TempDir dir;
   const auto sim = simulate(dir);
+  // The file run on one worker thread, the live run on every core: the thread count changes no
+  // output (the parallel sums add fixed blocks in a fixed order).
   const auto file_run = sim / "file_run";
   const test::TaigaResult file =
       test::runTaiga("run " + (sim / "capture.pcap").string() + " --config " +
-                     (sim / "rig.yaml").string() + " --out " + file_run.string());
+                     (sim / "rig.yaml").string() + " --out " + file_run.string() + " --threads 1");
   ASSERT_EQ(file.exit_code, 0) << file.output;
+  EXPECT_THAT(file.output, HasSubstr("per scan on 1 thread;"));
+  EXPECT_EQ(nlohmann::json::parse(readText(file_run / "summary.json"))["threads"], 1);
 
   const auto live_run = sim / "live_run";
   PoseReceiver pose_receiver;

@@ -4,6 +4,7 @@
 
 #include "taiga/core/config.hpp"
 #include "taiga/core/calibration_config.hpp"
+#include "taiga/core/compute_config.hpp"
 #include "taiga/core/georef_config.hpp"
 #include "taiga/core/live_config.hpp"
 #include "taiga/core/mapping_config.hpp"
@@ -21,6 +22,7 @@ struct SystemConfig final : ConfigSection {
   GeorefConfig georef;
   CalibrationConfig calibration;
   LiveConfig live;
+  ComputeConfig compute;
 
   void visit(ConfigVisitor& v) override {
     v.section("rig", rig, "sensor rig: extrinsics, clock offset and units");
@@ -32,6 +34,7 @@ struct SystemConfig final : ConfigSection {
     v.section("calibration", calibration,
               "self-calibration of the lidar-IMU time offset and extrinsic rotation");
     v.section("live", live, "taiga run --live: the sensor's UDP packets, and what a live run does");
+    v.section("compute", compute, "how much of the machine a run may use");
   }
 };
 
