@@ -102,7 +102,7 @@ ScanOutcome Odometry::firstScanOutcome(FirstScan&& first) {
   outcome.bias = first.state.bias;
   outcome.lidar = LidarFactor::kFirstScan;
   judgeHealth(outcome, false);
-  maybeAddKeyframe(outcome, first.cloud_in_body);
+  maybeAddKeyframe(outcome, std::move(first.cloud_in_body));
   return outcome;
 }
 
@@ -122,7 +122,7 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   MotionPrediction prediction = motion_->predict(scan);
   outcome.imu_rate_poses = std::move(prediction.imu_rate_poses);
   outcome.imu_gap_s = prediction.imu_gap_s;
-  const PointCloud cloud_in_body = preparation_->deskewedInBody(scan, prediction.sweep_T_odom_body);
+  PointCloud cloud_in_body = preparation_->deskewedInBody(scan, prediction.sweep_T_odom_body);
   outcome.timing.deskew_ms = msSince(start);
 
   // 3. Voxel filter.
@@ -179,7 +179,7 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   // With an IMU the wide basin is rare and keeps no yardstick: every such scan is searched.
   if (lidar_only_ && has_map && outcome.health.status == ScanStatus::kOk)
     wide_basin_->rememberLast();
-  maybeAddKeyframe(outcome, cloud_in_body);
+  maybeAddKeyframe(outcome, std::move(cloud_in_body));
   outcome.timing.map_ms = msSince(stage);
   outcome.timing.total_ms = msSince(start);
   return outcome;
@@ -250,7 +250,7 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
   outcome.map_segment = map_segment_;
 }
 
-void Odometry::maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body) {
+void Odometry::maybeAddKeyframe(ScanOutcome& outcome, PointCloud&& cloud_in_body) {
   // A scan the monitor distrusts never enters the map, but an empty map takes the next scan
   // whatever its status: there is nothing else to register to.
   if (outcome.health.status != ScanStatus::kOk && !local_map_.empty()) return;
@@ -266,7 +266,7 @@ void Odometry::maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in
   local_map_.addKeyframe(
       *outcome.keyframe_id, outcome.T_odom_body,
       preprocess::voxelFilter(cloud_in_body, config_.local_map_voxel_m).positions);
-  outcome.keyframe_cloud_in_body = cloud_in_body;
+  outcome.keyframe_cloud_in_body = std::move(cloud_in_body);
 }
 
 }  // namespace taiga::pipeline

@@ -17,13 +17,12 @@ ScanPreparation::ScanPreparation(const OdometryConfig& config, const RigConfig& 
 // The rig is rigid with the body, so a point is tested against the boxes at its own firing time,
 // before deskewing: exact for any motion during the sweep.
 PointCloud ScanPreparation::forestPointsInLidar(const io::Scan& scan) const {
-  const PointCloud in_range =
-      preprocess::keepRange(scan.cloud_in_lidar, min_range_m_, max_range_m_);
   std::vector<OrientedBox> boxes_lidar = self_boxes_lidar_;
   const lie::SE3 T_lidar_body = T_body_lidar_.inverse();
   for (const OrientedBox& box_body : moving_boxes_body_.forScan(scan.t_start_s, scan.t_end_s))
     boxes_lidar.push_back(box_body.expressedIn(T_lidar_body));
-  return preprocess::removeInsideBoxes(in_range, boxes_lidar);
+  return preprocess::keepRangeOutsideBoxes(scan.cloud_in_lidar, min_range_m_, max_range_m_,
+                                           boxes_lidar);
 }
 
 PointCloud ScanPreparation::deskewedInBody(const io::Scan& scan,

@@ -7,18 +7,36 @@ namespace taiga::preprocess {
 
 namespace {
 
+// One select for any test: each select copies every channel of the kept points.
+template <class Keep>
+PointCloud keepIf(const PointCloud& cloud, Keep keep) {
+  std::vector<std::size_t> kept;
+  kept.reserve(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (keep(cloud.positions[i])) kept.push_back(i);
+  return cloud.select(kept);
+}
+
+template <class AnyBox>
+bool insideAny(std::span<const AnyBox> boxes, const Eigen::Vector3d& p) {
+  return std::any_of(boxes.begin(), boxes.end(), [&](const AnyBox& box) { return box.contains(p); });
+}
+
 template <class AnyBox>
 PointCloud removeInside(const PointCloud& cloud, std::span<const AnyBox> boxes) {
   if (boxes.empty()) return cloud;
-  std::vector<std::size_t> kept;
-  kept.reserve(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3d& p = cloud.positions[i];
-    if (std::none_of(boxes.begin(), boxes.end(), [&](const AnyBox& box) { return box.contains(p); }))
-      kept.push_back(i);
-  }
-  return cloud.select(kept);
+  return keepIf(cloud, [&](const Eigen::Vector3d& p) { return !insideAny(boxes, p); });
 }
+
+struct InRange {
+  double min2, max2;
+  InRange(double min_range_m, double max_range_m)
+      : min2(min_range_m * min_range_m), max2(max_range_m * max_range_m) {}
+  bool operator()(const Eigen::Vector3d& p) const {
+    const double r2 = p.squaredNorm();
+    return r2 >= min2 && r2 <= max2;
+  }
+};
 
 }  // namespace
 
@@ -31,14 +49,14 @@ PointCloud removeInsideBoxes(const PointCloud& cloud, std::span<const OrientedBo
 }
 
 PointCloud keepRange(const PointCloud& cloud, double min_range_m, double max_range_m) {
-  std::vector<std::size_t> kept;
-  kept.reserve(cloud.size());
-  const double min2 = min_range_m * min_range_m, max2 = max_range_m * max_range_m;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const double r2 = cloud.positions[i].squaredNorm();
-    if (r2 >= min2 && r2 <= max2) kept.push_back(i);
-  }
-  return cloud.select(kept);
+  return keepIf(cloud, InRange(min_range_m, max_range_m));
+}
+
+PointCloud keepRangeOutsideBoxes(const PointCloud& cloud, double min_range_m, double max_range_m,
+                                 std::span<const OrientedBox> boxes) {
+  const InRange in_range(min_range_m, max_range_m);
+  return keepIf(cloud,
+                [&](const Eigen::Vector3d& p) { return in_range(p) && !insideAny(boxes, p); });
 }
 
 }  // namespace taiga::preprocess

@@ -19,7 +19,7 @@ lie::SE3 clampedPoseAt(const Trajectory& trajectory, double t_s) {
 
 }  // namespace
 
-DeskewedScan deskew(const PointCloud& cloud_in_lidar, const lie::SE3& T_body_lidar,
+DeskewedScan deskew(PointCloud cloud_in_lidar, const lie::SE3& T_body_lidar,
                     const Trajectory& trajectory_world_body, double t_ref_s) {
   if (!cloud_in_lidar.empty() && !cloud_in_lidar.hasTimes())
     throw std::invalid_argument("deskew: the cloud has no per-point times");
@@ -27,19 +27,26 @@ DeskewedScan deskew(const PointCloud& cloud_in_lidar, const lie::SE3& T_body_lid
 
   DeskewedScan result;
   result.t_ref_s = t_ref_s;
-  result.cloud_in_body = cloud_in_lidar;
 
   // Points share times (one per column, thesis Eq. 35): one pose per distinct time, found through
-  // a hash map (sorting the times of 128k points cost more than the deskew itself).
+  // a hash map (sorting the times of 128k points cost more than the deskew itself). A column's
+  // points usually come one after another, so the previous point's time is tried first.
   tsl::robin_map<std::uint64_t, std::uint32_t, MixedKeyHash> index_of_time;
   std::vector<double> distinct_times;
   std::vector<std::uint32_t> time_index(cloud_in_lidar.size());
+  std::uint64_t previous_bits = 0;
+  std::uint32_t previous_index = 0;
   for (std::size_t i = 0; i < cloud_in_lidar.size(); ++i) {
     const double t = cloud_in_lidar.times_s[i] + 0.0;  // + 0.0 turns -0 into +0
-    auto [it, inserted] = index_of_time.try_emplace(std::bit_cast<std::uint64_t>(t),
-                                                    static_cast<std::uint32_t>(distinct_times.size()));
-    if (inserted) distinct_times.push_back(t);
-    time_index[i] = it->second;
+    const auto bits = std::bit_cast<std::uint64_t>(t);
+    if (i == 0 || bits != previous_bits) {
+      auto [it, inserted] =
+          index_of_time.try_emplace(bits, static_cast<std::uint32_t>(distinct_times.size()));
+      if (inserted) distinct_times.push_back(t);
+      previous_bits = bits;
+      previous_index = it->second;
+    }
+    time_index[i] = previous_index;
   }
 
   // T_bodyref_lidar(t) = T_world_body(t_ref)^-1 * T_world_body(t) * T_body_lidar, per distinct
@@ -58,10 +65,11 @@ DeskewedScan deskew(const PointCloud& cloud_in_lidar, const lie::SE3& T_body_lid
     outside[k] = !trajectory_world_body.covers(distinct_times[k]);
   for (std::size_t i = 0; i < cloud_in_lidar.size(); ++i) {
     const std::uint32_t k = time_index[i];
-    result.cloud_in_body.positions[i] =
-        rotations[k] * cloud_in_lidar.positions[i] + translations[k];
+    Eigen::Vector3d& p = cloud_in_lidar.positions[i];  // in the lidar frame, then in the body's
+    p = rotations[k] * p + translations[k];
     result.clamped_points += outside[k];
   }
+  result.cloud_in_body = std::move(cloud_in_lidar);
   return result;
 }
 

@@ -49,16 +49,24 @@ PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m,
   std::vector<Cell> cells;
   std::vector<std::uint32_t> cell_of_point(cloud.size(), kDropped);
   tsl::robin_map<std::uint64_t, std::uint32_t, MixedKeyHash> cell_of_key;
+  // A spinning lidar's neighbouring returns (down a column) often share a voxel: the previous
+  // point's cell is tried before the hash map.
+  std::uint64_t previous_key = 0;
+  std::uint32_t previous_cell = kDropped;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d& p = cloud.positions[i];
     if (!p.allFinite()) continue;
     const std::uint64_t key = voxelKey(p, inverse_size);
-    auto [it, inserted] = cell_of_key.try_emplace(key, static_cast<std::uint32_t>(cells.size()));
-    if (inserted) cells.push_back(Cell{key});
-    Cell& cell = cells[it->second];
+    if (previous_cell == kDropped || key != previous_key) {
+      auto [it, inserted] = cell_of_key.try_emplace(key, static_cast<std::uint32_t>(cells.size()));
+      if (inserted) cells.push_back(Cell{key});
+      previous_key = key;
+      previous_cell = it->second;
+    }
+    Cell& cell = cells[previous_cell];
     cell.sum += p;  // in point order, as the sorted version summed them
     ++cell.count;
-    cell_of_point[i] = it->second;
+    cell_of_point[i] = previous_cell;
   }
   for (Cell& cell : cells) cell.sum /= static_cast<double>(cell.count);  // now the centroid
   for (std::size_t i = 0; i < cloud.size(); ++i) {

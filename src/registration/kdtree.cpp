@@ -2,6 +2,9 @@
 
 #include <nanoflann.hpp>
 
+#include <cmath>
+#include <limits>
+
 #include "block_reduce.hpp"
 
 namespace taiga::registration {
@@ -19,6 +22,31 @@ struct Adaptor {
 
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Adaptor>,
                                                  Adaptor, 3, std::size_t>;
+
+// nanoflann's result set for "the nearest point within a radius": like its KNNResultSet with
+// k = 1 (a point replaces the best only when strictly closer), but starting from the radius
+// instead of infinity, so that subtrees beyond it are never visited.
+class NearestWithin {
+ public:
+  explicit NearestWithin(double max_squared_m2)
+      : best_(std::nextafter(max_squared_m2, std::numeric_limits<double>::infinity())) {}
+  bool addPoint(double squared_m2, std::size_t index) {
+    if (squared_m2 < best_) {
+      best_ = squared_m2;
+      index_ = index;
+      found_ = true;
+    }
+    return true;  // keep searching
+  }
+  double worstDist() const { return best_; }
+  bool full() const { return found_; }
+  std::size_t index() const { return index_; }
+
+ private:
+  double best_;
+  std::size_t index_ = 0;
+  bool found_ = false;
+};
 
 }  // namespace
 
@@ -50,6 +78,17 @@ bool KdTree::nearest(const Eigen::Vector3d& query, std::size_t& index,
   return knn(query, 1, &index, &squared_distance_m2) == 1;
 }
 
+bool KdTree::nearestWithin(const Eigen::Vector3d& query, double max_distance_m, std::size_t& index,
+                           double& squared_distance_m2) const {
+  if (impl_->points.empty()) return false;
+  NearestWithin result(max_distance_m * max_distance_m);
+  impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  if (!result.full()) return false;
+  index = result.index();
+  squared_distance_m2 = result.worstDist();
+  return true;
+}
+
 Agreement agreement(std::span<const Eigen::Vector3d> source, const KdTree& target,
                     const lie::SE3& T_target_source, double max_distance_m) {
   struct Partial {
@@ -58,13 +97,12 @@ Agreement agreement(std::span<const Eigen::Vector3d> source, const KdTree& targe
   };
   const Eigen::Matrix3d R = T_target_source.rotation().matrix();
   const Eigen::Vector3d t = T_target_source.translation();
-  const double max_sq = max_distance_m * max_distance_m;
   const Partial total = detail::reduceInBlocks<Partial>(
       source.size(),
       [&](std::size_t i, Partial& out) {
         std::size_t index;
         double sq;
-        if (target.nearest(R * source[i] + t, index, sq) && sq <= max_sq) {
+        if (target.nearestWithin(R * source[i] + t, max_distance_m, index, sq)) {
           out.sum += sq;
           ++out.count;
         }

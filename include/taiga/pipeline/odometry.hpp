@@ -146,7 +146,8 @@ class Odometry {
   /// One registration from one guess, with its fitness.
   registration::RegistrationResult alignToMap(const std::vector<Eigen::Vector3d>& source,
                                               const lie::SE3& guess_T_odom_body) const;
-  void maybeAddKeyframe(ScanOutcome& outcome, const PointCloud& cloud_in_body);
+  /// Takes the scan's full cloud: a keyframe keeps it in its outcome.
+  void maybeAddKeyframe(ScanOutcome& outcome, PointCloud&& cloud_in_body);
   void judgeHealth(ScanOutcome& outcome, bool registered);
 
   OdometryConfig config_;

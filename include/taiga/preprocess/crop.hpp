@@ -20,5 +20,9 @@ PointCloud removeInsideBoxes(const PointCloud& cloud, std::span<const OrientedBo
 
 /// The points whose distance from the frame's origin lies in [min_range_m, max_range_m].
 PointCloud keepRange(const PointCloud& cloud, double min_range_m, double max_range_m);
+/// Both in one pass (one copy of the kept points): in [min_range_m, max_range_m] and outside
+/// every box.
+PointCloud keepRangeOutsideBoxes(const PointCloud& cloud, double min_range_m, double max_range_m,
+                                 std::span<const OrientedBox> boxes);
 
 }  // namespace taiga::preprocess

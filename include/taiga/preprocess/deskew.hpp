@@ -22,7 +22,9 @@ struct DeskewedScan {
 /// p_body(t_ref) = T_world_body(t_ref)^-1 * T_world_body(t_i) * T_body_lidar * p_lidar_i.
 /// `cloud_in_lidar` must carry per-point times; `trajectory_world_body` must not be empty.
 /// Throws std::invalid_argument otherwise.
-DeskewedScan deskew(const PointCloud& cloud_in_lidar, const lie::SE3& T_body_lidar,
+/// The cloud is taken by value: a caller that no longer needs it moves it in, and its positions
+/// are overwritten in place rather than copied.
+DeskewedScan deskew(PointCloud cloud_in_lidar, const lie::SE3& T_body_lidar,
                     const Trajectory& trajectory_world_body, double t_ref_s);
 
 }  // namespace taiga::preprocess

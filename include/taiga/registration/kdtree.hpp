@@ -27,6 +27,10 @@ class KdTree {
                   double* squared_distances_m2) const;
   /// The nearest point; false for an empty tree.
   bool nearest(const Eigen::Vector3d& query, std::size_t& index, double& squared_distance_m2) const;
+  /// The nearest point if it lies within max_distance_m (inclusive): the same point as nearest(),
+  /// but the search stops at that radius, so a query far from every point costs little.
+  bool nearestWithin(const Eigen::Vector3d& query, double max_distance_m, std::size_t& index,
+                     double& squared_distance_m2) const;
 
  private:
   struct Impl;
