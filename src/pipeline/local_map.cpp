@@ -61,14 +61,23 @@ void LocalMap::account(const Keyframe& keyframe, Change change) {
 
 void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
                            std::vector<Eigen::Vector3d> points_in_keyframe) {
-  finishPendingBuild();  // it reads the statistics that change now
+  finishPendingBuild();  // it reads the statistics and keyframes that change now
   keyframes_.push_back({id, T_odom_keyframe, std::move(points_in_keyframe)});
-  account(keyframes_.back(), Change::kAdd);
+  std::vector<Keyframe> dropped;
   while (static_cast<int>(keyframes_.size()) > max_keyframes_) {
-    account(keyframes_.front(), Change::kRemove);
+    dropped.push_back(std::move(keyframes_.front()));
     keyframes_.pop_front();
   }
-  pending_ = std::async(std::launch::async, [this] { return build(); });
+  // The statistics are brought up to date in the background, before the build: on the main
+  // thread they made the keyframe's scan twice as slow as any other (bench/BENCHMARK.md,
+  // "Session 37"). Nothing else reads them until finishPendingBuild().
+  pending_ = std::async(std::launch::async,
+                        [this, &added = keyframes_.back(), dropped = std::move(dropped)] {
+                          account(added, Change::kAdd);
+                          for (const Keyframe& keyframe : dropped)
+                            account(keyframe, Change::kRemove);
+                          return build();
+                        });
   registrations_since_keyframe_ = 0;
 }
 
