@@ -62,7 +62,8 @@ TEST(LocalMap, ReposingInPlaceKeepsTheMap) {
   map.addKeyframe(0, lie::SE3(), corner);
   map.addKeyframe(1, lie::SE3(lie::SO3(), {0.5, 0.0, 0.0}), corner);
   const lie::SE3 guess(lie::SO3(), {0.2, 0.1, 0.0});
-  registerFrom(map, corner, guess);  // on the structures without the second keyframe
+  for (int i = 0; i < LocalMap::kScansOnPreviousMap; ++i)
+    registerFrom(map, corner, guess);  // on the structures without the second keyframe
   const lie::SE3 before = registerFrom(map, corner, guess);
   const std::size_t points = map.numPoints();
   map.repose([](std::uint64_t, const lie::SE3& T_old) { return T_old; });
