@@ -1,6 +1,7 @@
 #include "taiga/preprocess/voxel_filter.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -9,6 +10,9 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tsl/robin_map.h>
 
 #include "taiga/core/hash.hpp"
@@ -29,70 +33,102 @@ std::uint64_t voxelKey(const Eigen::Vector3d& p, double inverse_size) {
   return key;
 }
 
+constexpr std::uint64_t kNoKey = std::numeric_limits<std::uint64_t>::max();  // a NaN point
+
+/// The cells of the voxels whose keys fall into one partition. Every voxel belongs to exactly
+/// one partition and each partition visits its points in index order, so a cell's sum and its
+/// nearest point are the same, bit for bit, whatever the number of partitions or threads.
+class Partition {
+ public:
+  struct Cell {
+    std::uint64_t key = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();  ///< then the centroid
+    std::size_t count = 0;
+    std::size_t nearest = 0;
+    double nearest_d2 = std::numeric_limits<double>::infinity();
+  };
+  static constexpr unsigned kCount = 4;  ///< partitions: enough for the cores of a small PC
+  static unsigned of(std::uint64_t key) {
+    return static_cast<unsigned>(MixedKeyHash{}(key) >> 62);  // top bits: the map uses the low
+  }
+
+  void gather(const std::vector<Eigen::Vector3d>& positions, const std::vector<std::uint64_t>& keys,
+              unsigned part) {
+    std::vector<std::uint32_t> mine, cell_of_mine;  // my points, and their cells
+    tsl::robin_map<std::uint64_t, std::uint32_t, MixedKeyHash> cell_of_key;
+    cell_of_key.reserve(keys.size() / (4 * kCount));  // a scan has 2-8 points per voxel
+    // A spinning lidar's neighbouring returns (down a column) often share a voxel: the previous
+    // point's cell is tried before the hash map.
+    std::uint64_t previous_key = kNoKey;
+    std::uint32_t previous_cell = 0;
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const std::uint64_t key = keys[i];
+      if (key == kNoKey || of(key) != part) continue;
+      if (key != previous_key) {
+        auto [it, inserted] = cell_of_key.try_emplace(key, static_cast<std::uint32_t>(cells.size()));
+        if (inserted) cells.push_back(Cell{key});
+        previous_key = key;
+        previous_cell = it->second;
+      }
+      Cell& cell = cells[previous_cell];
+      cell.sum += positions[i];  // in point order
+      ++cell.count;
+      mine.push_back(static_cast<std::uint32_t>(i));
+      cell_of_mine.push_back(previous_cell);
+    }
+    for (Cell& cell : cells) cell.sum /= static_cast<double>(cell.count);
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      Cell& cell = cells[cell_of_mine[k]];
+      const double d2 = (positions[mine[k]] - cell.sum).squaredNorm();
+      if (d2 < cell.nearest_d2) {  // ties keep the lowest index
+        cell.nearest_d2 = d2;
+        cell.nearest = mine[k];
+      }
+    }
+  }
+
+  std::vector<Cell> cells;
+};
+
 }  // namespace
 
 PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m,
                        VoxelRepresentative representative) {
   if (!(voxel_size_m > 0.0))
     throw std::invalid_argument("voxelFilter: voxel_size_m must be positive");
+  if (cloud.size() > std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("voxelFilter: more than 2^32 points");
   const double inverse_size = 1.0 / voxel_size_m;
 
-  // Points are gathered into cells through a hash map and only the cells are sorted by key: a
-  // scan has 5-10 times more points than occupied voxels, and sorting the points was the cost.
-  constexpr std::uint32_t kDropped = std::numeric_limits<std::uint32_t>::max();
-  struct Cell {
-    std::uint64_t key = 0;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    std::size_t count = 0;
-    std::size_t nearest = 0;
-    double nearest_d2 = std::numeric_limits<double>::infinity();
-  };
-  std::vector<Cell> cells;
-  std::vector<std::uint32_t> cell_of_point(cloud.size(), kDropped);
-  tsl::robin_map<std::uint64_t, std::uint32_t, MixedKeyHash> cell_of_key;
-  // A spinning lidar's neighbouring returns (down a column) often share a voxel: the previous
-  // point's cell is tried before the hash map.
-  std::uint64_t previous_key = 0;
-  std::uint32_t previous_cell = kDropped;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3d& p = cloud.positions[i];
-    if (!p.allFinite()) continue;
-    const std::uint64_t key = voxelKey(p, inverse_size);
-    if (previous_cell == kDropped || key != previous_key) {
-      auto [it, inserted] = cell_of_key.try_emplace(key, static_cast<std::uint32_t>(cells.size()));
-      if (inserted) cells.push_back(Cell{key});
-      previous_key = key;
-      previous_cell = it->second;
-    }
-    Cell& cell = cells[previous_cell];
-    cell.sum += p;  // in point order, as the sorted version summed them
-    ++cell.count;
-    cell_of_point[i] = previous_cell;
-  }
-  for (Cell& cell : cells) cell.sum /= static_cast<double>(cell.count);  // now the centroid
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (cell_of_point[i] == kDropped) continue;
-    Cell& cell = cells[cell_of_point[i]];
-    const double d2 = (cloud.positions[i] - cell.sum).squaredNorm();
-    if (d2 < cell.nearest_d2) {  // ties keep the lowest index
-      cell.nearest_d2 = d2;
-      cell.nearest = i;
-    }
-  }
-  // Keys are distinct, so the order is the same whatever is sorted; (key, cell) pairs move a
-  // third of the bytes the cells would.
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> order(cells.size());
-  for (std::size_t c = 0; c < cells.size(); ++c)
-    order[c] = {cells[c].key, static_cast<std::uint32_t>(c)};
-  std::sort(order.begin(), order.end());
+  // Points are gathered into cells through hash maps (one per partition, in parallel) and only
+  // the cells are sorted by key: a scan has 5-10 times more points than occupied voxels, and
+  // sorting the points was the cost.
+  const std::vector<Eigen::Vector3d>& positions = cloud.positions;
+  std::vector<std::uint64_t> keys(positions.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 8192),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i)
+                        keys[i] = positions[i].allFinite() ? voxelKey(positions[i], inverse_size)
+                                                           : kNoKey;
+                    });
+  std::array<Partition, Partition::kCount> partitions;
+  tbb::parallel_for(0u, Partition::kCount,
+                    [&](unsigned part) { partitions[part].gather(positions, keys, part); });
+
+  // Keys are distinct, so the order is the same whatever is sorted: (key, cell) pairs.
+  std::vector<std::pair<std::uint64_t, const Partition::Cell*>> order;
+  for (const Partition& partition : partitions)
+    for (const Partition::Cell& cell : partition.cells) order.emplace_back(cell.key, &cell);
+  tbb::parallel_sort(order.begin(), order.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
 
   std::vector<Eigen::Vector3d> centroids;
   std::vector<std::size_t> representatives;
-  centroids.reserve(cells.size());
-  representatives.reserve(cells.size());
-  for (const auto& [key, c] : order) {
-    centroids.push_back(cells[c].sum);
-    representatives.push_back(cells[c].nearest);
+  centroids.reserve(order.size());
+  representatives.reserve(order.size());
+  for (const auto& [key, cell] : order) {
+    centroids.push_back(cell->sum);
+    representatives.push_back(cell->nearest);
   }
   PointCloud filtered = cloud.select(representatives);  // positions: the nearest returns
   if (representative == VoxelRepresentative::centroid) filtered.positions = std::move(centroids);
