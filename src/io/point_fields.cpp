@@ -13,16 +13,16 @@
 #include "taiga/core/errors.hpp"
 
 namespace taiga::io {
-namespace {
-
-}  // namespace
 
 double unpackValue(const std::uint8_t* p, FieldType type, bool swap) {
-  std::uint8_t bytes[8];
-  const std::size_t size = fieldTypeSize(type);
-  std::memcpy(bytes, p, size);
-  if (swap) std::reverse(bytes, bytes + size);
-  auto as = [&bytes]<class T>(T) {
+  // Each type copies its own constant number of bytes: a copy of a size known only at run time
+  // was a call into the C library per value, the largest part of decoding a scan.
+  auto as = [p, swap]<class T>(T) {
+    std::uint8_t bytes[sizeof(T)];
+    if (swap)
+      std::reverse_copy(p, p + sizeof(T), bytes);
+    else
+      std::memcpy(bytes, p, sizeof(T));
     T value;
     std::memcpy(&value, bytes, sizeof(T));
     return static_cast<double>(value);
