@@ -180,6 +180,12 @@ TEST(Cli, ConfigPrintsDefaultsAndNamesBadKeys) {
   const Result ok = runTaiga("config " + good.string());
   EXPECT_EQ(ok.exit_code, 0);
   EXPECT_THAT(ok.output, HasSubstr("quaternion_xyzw: [0, 0, 1, 6.123233995736766e-17]"));
+
+  const auto threads = dir.write("threads.yaml", "compute:\n  threads: -2\n");
+  const Result bad_threads = runTaiga("config " + threads.string());
+  EXPECT_EQ(bad_threads.exit_code, 2);
+  EXPECT_THAT(bad_threads.output, HasSubstr("compute.threads: expected a value in [0, 1024]"));
+  EXPECT_EQ(runTaiga("run x.bag --out y --threads -1").exit_code, 2);  // the flag is checked too
 }
 
 }  // namespace

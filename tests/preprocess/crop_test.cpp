@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 namespace taiga::preprocess {
 namespace {
 
@@ -23,6 +25,25 @@ TEST(Crop, KeepsTheRangeInterval) {
   ASSERT_EQ(kept.size(), 2u);
   EXPECT_DOUBLE_EQ(kept.positions[0].y(), 3.0);
   EXPECT_DOUBLE_EQ(kept.positions[1].x(), 1.0);
+}
+
+TEST(Crop, RangeAndBoxesInOnePassAsOneAfterTheOther) {
+  PointCloud cloud;
+  for (int i = 0; i < 200; ++i) {
+    cloud.positions.emplace_back(0.1 * i - 10.0, 0.05 * i - 3.0, 0.02 * i);
+    cloud.times_s.push_back(i);
+  }
+  const std::vector<OrientedBox> boxes{
+      OrientedBox::fromBox({{-2, -4, -1}, {1, 0, 5}}),
+      {{5, 3, 2}, {1, 2, 1}, Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix()}};
+  const PointCloud both = keepRangeOutsideBoxes(cloud, 1.0, 8.0, boxes);
+  const PointCloud in_turn = removeInsideBoxes(keepRange(cloud, 1.0, 8.0), boxes);
+  ASSERT_GT(both.size(), 20u);
+  ASSERT_LT(both.size(), keepRange(cloud, 1.0, 8.0).size());  // the boxes took some
+  EXPECT_EQ(both.positions, in_turn.positions);
+  EXPECT_EQ(both.times_s, in_turn.times_s);
+  EXPECT_EQ(keepRangeOutsideBoxes(cloud, 1.0, 8.0, {}).positions,
+            keepRange(cloud, 1.0, 8.0).positions);
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <limits>
 #include <random>
 
+#include <tbb/global_control.h>
+
 namespace taiga::preprocess {
 namespace {
 
@@ -54,6 +56,37 @@ TEST(VoxelFilter, SameOutputWhateverTheInputOrderAndDropsNonFinitePoints) {
     EXPECT_LT((once.positions[i] - shuffled.positions[i]).norm(), 1e-12);
   }
   EXPECT_LT(once.size(), cloud.size());
+}
+
+TEST(VoxelFilter, TheSameBitsOnOneWorkerThreadAsOnMany) {
+  // The voxels are split into partitions filtered in parallel; each voxel's points are still
+  // summed in index order, so the thread count changes nothing (the odometry's outputs rely on
+  // it: docs/architecture.md, "Threads").
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> coordinate(-30.0, 30.0);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 50000; ++i)
+    points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng) * 0.2);
+  const PointCloud cloud = cloudOf(points);
+  const PointCloud many = voxelFilter(cloud, 0.4, VoxelRepresentative::centroid);
+  const PointCloud measured_many = voxelFilter(cloud, 0.4, VoxelRepresentative::measured);
+  PointCloud one, measured_one;
+  {
+    const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = voxelFilter(cloud, 0.4, VoxelRepresentative::centroid);
+    measured_one = voxelFilter(cloud, 0.4, VoxelRepresentative::measured);
+  }
+  ASSERT_GT(many.size(), 10000u);
+  EXPECT_EQ(one.positions, many.positions);  // exactly
+  EXPECT_EQ(one.times_s, many.times_s);
+  EXPECT_EQ(measured_one.positions, measured_many.positions);
+  // In key order (x, then y, then z voxel index), as before the partitions.
+  for (std::size_t i = 1; i < many.size(); ++i) {
+    const Eigen::Vector3d a = (many.positions[i - 1] / 0.4).array().floor();
+    const Eigen::Vector3d b = (many.positions[i] / 0.4).array().floor();
+    ASSERT_TRUE(std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3))
+        << i;
+  }
 }
 
 TEST(VoxelFilter, KeepsTheChannelsOfThePointNearestTheCentroid) {

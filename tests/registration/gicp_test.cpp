@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <random>
 #include <vector>
 
 #include "registration_data.hpp"
@@ -120,6 +121,40 @@ TEST(Fitness, IsTheMeanSquaredDistanceToTheClosestTargetPoint) {
   // Moved by +1 m in x: distances 2 and 2.
   EXPECT_DOUBLE_EQ(fitnessScore(source, tree, lie::SE3(lie::SO3(), {1.0, 0.0, 0.0})), 4.0);
   EXPECT_DOUBLE_EQ(fitnessScore(source, tree, lie::SE3(), 2.0), 1.0);  // 3 m is beyond 2 m
+}
+
+TEST(KdTree, NearestWithinARadiusIsTheNearestPointWhenItLiesWithin) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> coordinate(-10.0, 10.0);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 5000; ++i) points.emplace_back(coordinate(rng), coordinate(rng), 0.0);
+  const KdTree tree(points);
+  int within = 0, beyond = 0;
+  for (int q = 0; q < 2000; ++q) {
+    // Queries off the plane, some farther from it than the radius.
+    const Eigen::Vector3d query(coordinate(rng), coordinate(rng), 0.1 * coordinate(rng));
+    std::size_t nearest = 0, bounded = 0;
+    double nearest_sq = 0.0, bounded_sq = 0.0;
+    ASSERT_TRUE(tree.nearest(query, nearest, nearest_sq));
+    const double radius_m = 0.5;
+    if (tree.nearestWithin(query, radius_m, bounded, bounded_sq)) {
+      ++within;
+      EXPECT_EQ(bounded, nearest);
+      EXPECT_EQ(bounded_sq, nearest_sq);
+      EXPECT_LE(bounded_sq, radius_m * radius_m);
+    } else {
+      ++beyond;
+      EXPECT_GT(nearest_sq, radius_m * radius_m);
+    }
+  }
+  EXPECT_GT(within, 100);
+  EXPECT_GT(beyond, 100);
+  // Inclusive at the radius; nothing in an empty tree.
+  std::size_t index = 0;
+  double sq = 0.0;
+  EXPECT_TRUE(KdTree(std::vector<Eigen::Vector3d>{{1, 0, 0}})
+                  .nearestWithin(Eigen::Vector3d::Zero(), 1.0, index, sq));
+  EXPECT_FALSE(KdTree(std::vector<Eigen::Vector3d>{}).nearestWithin({0, 0, 0}, 1.0, index, sq));
 }
 
 TEST(Registration, FacadeFillsTheFitnessScore) {
