@@ -213,7 +213,7 @@ void throwIfNoLidarData(const io::ouster::LiveStats& live, const std::string& so
 
 /// Caps the worker threads of the parallel stages for as long as it lives (compute.threads).
 /// The pipeline's own threads (reading, building the next local map, the mapping back end) are
-/// not workers: they mostly wait, and docs/architecture.md lists them.
+/// not capped; docs/architecture.md lists them and what they cost.
 class ThreadLimit {
  public:
   explicit ThreadLimit(int threads) {
