@@ -30,10 +30,11 @@ class LocalMap {
  public:
   /// Which registration target the map serves.
   enum class Target { kNdt, kGicp };
-  /// Registrations after a keyframe that still use the structures without it: the background
-  /// update and build take about two scans' processing time on two cores, and the second scan
-  /// after a keyframe waited for them when this was 1 (bench/BENCHMARK.md, "Session 37").
-  static constexpr int kScansOnPreviousMap = 2;
+  /// Registrations after a keyframe that still use the structures without it. The background
+  /// update and build take about two scans' time on two cores, so the second scan after a
+  /// keyframe often waits for them; 2 removed that wait but lost a lidar-only walk's
+  /// relocalization after a blind stretch (bench/BENCHMARK.md, "Session 37").
+  static constexpr int kScansOnPreviousMap = 1;
 
   /// NDT cells at each of ndt_resolutions_m (coarse to fine, at least one); the kd-tree
   /// (fitness, GICP) over one point per point_spacing_m voxel, so overlapping keyframes do not
