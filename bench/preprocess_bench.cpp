@@ -67,15 +67,14 @@ int main(int argc, char** argv) {
     std::vector<std::vector<double>> ms(5);
     for (const io::Scan& scan : scans) {
       auto start = Clock::now();
-      PointCloud cropped =
-          preprocess::keepRangeOutsideBoxes(scan.cloud_in_lidar, o.min_range_m, o.max_range_m,
-                                            no_boxes);
+      PointCloud cropped = preprocess::keepRangeOutsideBoxes(scan.cloud_in_lidar, o.min_range_m,
+                                                             o.max_range_m, no_boxes);
       ms[0].push_back(msSince(start));
       start = Clock::now();
       const std::size_t n = cropped.size();
-      PointCloud in_body = preprocess::deskew(std::move(cropped), config.rig.T_body_lidar, truth,
-                                              scan.t_end_s)
-                               .cloud_in_body;
+      PointCloud in_body =
+          preprocess::deskew(std::move(cropped), config.rig.T_body_lidar, truth, scan.t_end_s)
+              .cloud_in_body;
       ms[1].push_back(msSince(start));
       start = Clock::now();
       const PointCloud source = preprocess::voxelFilter(in_body, o.voxel_size_m, representative);
@@ -93,8 +92,9 @@ int main(int argc, char** argv) {
   const double per_scan = static_cast<double>(runs) * static_cast<double>(scans.size());
   fmt::print("{} scans x {} runs; per scan {:.0f} points, {:.0f} after the crop, {:.0f} voxels\n",
              scans.size(), runs, points / per_scan, kept / per_scan, voxels / per_scan);
-  fmt::print("median ms per scan (median over runs); sum: what every scan pays (not the "
-             "keyframe's voxel filter)\n");
+  fmt::print(
+      "median ms per scan (median over runs); sum: what every scan pays (not the "
+      "keyframe's voxel filter)\n");
   for (int s = 0; s < 5; ++s) fmt::print("  {:18s} {:7.3f}\n", names[s], median(per_run[s]));
   return 0;
 }

@@ -236,8 +236,8 @@ registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::V
   }
   // Points farther than a few coarse NDT cells from the map are new ground, not misalignment.
   result.fitness_m2 =
-      registration::fitnessScore(fitnessSample(source), local_map_.kdTree(),
-                                 result.T_target_source, 2.0 * config_.coarsestNdtResolutionM());
+      registration::fitnessScore(fitnessSample(source), local_map_.kdTree(), result.T_target_source,
+                                 2.0 * config_.coarsestNdtResolutionM());
   return result;
 }
 

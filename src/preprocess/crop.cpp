@@ -19,7 +19,8 @@ PointCloud keepIf(const PointCloud& cloud, Keep keep) {
 
 template <class AnyBox>
 bool insideAny(std::span<const AnyBox> boxes, const Eigen::Vector3d& p) {
-  return std::any_of(boxes.begin(), boxes.end(), [&](const AnyBox& box) { return box.contains(p); });
+  return std::any_of(boxes.begin(), boxes.end(),
+                     [&](const AnyBox& box) { return box.contains(p); });
 }
 
 template <class AnyBox>

@@ -1,5 +1,10 @@
 #include "taiga/preprocess/voxel_filter.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <tsl/robin_map.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,11 +14,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
-#include <tsl/robin_map.h>
 
 #include "taiga/core/hash.hpp"
 
@@ -65,7 +65,8 @@ class Partition {
       const std::uint64_t key = keys[i];
       if (key == kNoKey || of(key) != part) continue;
       if (key != previous_key) {
-        auto [it, inserted] = cell_of_key.try_emplace(key, static_cast<std::uint32_t>(cells.size()));
+        auto [it, inserted] =
+            cell_of_key.try_emplace(key, static_cast<std::uint32_t>(cells.size()));
         if (inserted) cells.push_back(Cell{key});
         previous_key = key;
         previous_cell = it->second;

@@ -1,9 +1,8 @@
 #include "taiga/registration/kdtree.hpp"
 
-#include <nanoflann.hpp>
-
 #include <cmath>
 #include <limits>
+#include <nanoflann.hpp>
 
 #include "block_reduce.hpp"
 

@@ -2,9 +2,9 @@
 // The whole configuration of a taiga run: one section per module. Sections are added here as the
 // modules that own them land.
 
-#include "taiga/core/config.hpp"
 #include "taiga/core/calibration_config.hpp"
 #include "taiga/core/compute_config.hpp"
+#include "taiga/core/config.hpp"
 #include "taiga/core/georef_config.hpp"
 #include "taiga/core/live_config.hpp"
 #include "taiga/core/mapping_config.hpp"

@@ -150,7 +150,7 @@ struct RunSummary {
   double duration_s = 0.0;  ///< recording time covered by the states
   double path_length_m = 0.0;
   double mean_ms = 0.0, median_ms = 0.0, p95_ms = 0.0, p99_ms = 0.0, max_ms = 0.0;
-  int threads = 0;  ///< worker threads the parallel stages could use
+  int threads = 0;               ///< worker threads the parallel stages could use
   double wall_time_s = 0.0;      ///< reading, odometry and mapping graph, keyframe files included
   double map_export_s = 0.0;     ///< map.las (and map.ply) from keyframes/ at the end
   double realtime_factor = 0.0;  ///< recording duration / wall time (> 1: faster than the sensor)
