@@ -1,13 +1,12 @@
 #include "taiga/preprocess/voxel_filter.hpp"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
-
-#include <tbb/global_control.h>
 
 namespace taiga::preprocess {
 namespace {
@@ -19,6 +18,16 @@ PointCloud cloudOf(std::vector<Eigen::Vector3d> points) {
     cloud.times_s.push_back(static_cast<double>(i));
   }
   return cloud;
+}
+
+/// n points uniform in x, y within +-half_width_m and in z within +-z_scale * half_width_m.
+std::vector<Eigen::Vector3d> randomSlab(std::mt19937_64& rng, int n, double half_width_m,
+                                        double z_scale) {
+  std::uniform_real_distribution<double> coordinate(-half_width_m, half_width_m);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i)
+    points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng) * z_scale);
+  return points;
 }
 
 TEST(VoxelFilter, OnePointPerVoxelAtTheCentroid) {
@@ -40,10 +49,7 @@ TEST(VoxelFilter, OnePointPerVoxelAtTheCentroid) {
 
 TEST(VoxelFilter, SameOutputWhateverTheInputOrderAndDropsNonFinitePoints) {
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> coordinate(-20.0, 20.0);
-  std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < 20000; ++i)
-    points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng) * 0.1);
+  std::vector<Eigen::Vector3d> points = randomSlab(rng, 20000, 20.0, 0.1);
   points.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
   PointCloud cloud = cloudOf(points);
   const PointCloud once = voxelFilter(cloud, 0.5);
@@ -63,11 +69,7 @@ TEST(VoxelFilter, TheSameBitsOnOneWorkerThreadAsOnMany) {
   // summed in index order, so the thread count changes nothing (the odometry's outputs rely on
   // it: docs/architecture.md, "Threads").
   std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> coordinate(-30.0, 30.0);
-  std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < 50000; ++i)
-    points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng) * 0.2);
-  const PointCloud cloud = cloudOf(points);
+  const PointCloud cloud = cloudOf(randomSlab(rng, 50000, 30.0, 0.2));
   const PointCloud many = voxelFilter(cloud, 0.4, VoxelRepresentative::centroid);
   const PointCloud measured_many = voxelFilter(cloud, 0.4, VoxelRepresentative::measured);
   PointCloud one, measured_one;
@@ -84,8 +86,7 @@ TEST(VoxelFilter, TheSameBitsOnOneWorkerThreadAsOnMany) {
   for (std::size_t i = 1; i < many.size(); ++i) {
     const Eigen::Vector3d a = (many.positions[i - 1] / 0.4).array().floor();
     const Eigen::Vector3d b = (many.positions[i] / 0.4).array().floor();
-    ASSERT_TRUE(std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3))
-        << i;
+    ASSERT_TRUE(std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3)) << i;
   }
 }
 
