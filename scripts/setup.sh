@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs every Debian package taiga needs to build, test and benchmark, and the Node.js packages
-# that tests use: an independent LAS reader (tools/las-check) and Foxglove's WebSocket protocol
-# client (tools/foxglove-check).
+# Installs every Debian package taiga needs to build, test and benchmark, and the Node.js packages:
+# three.js for the web viewer (web/, compiled into the binary), and for tests an independent LAS
+# reader (tools/las-check), Foxglove's WebSocket protocol client (tools/foxglove-check) and
+# playwright-core driving Debian's Chromium (tools/viewer-check).
 # Idempotent and non-interactive: installs only what is missing, runs `apt-get update` first when it
 # has to install anything. Uses sudo when not run as root.
 set -euo pipefail
@@ -18,6 +19,8 @@ packages=(
   libpcap-dev librosbag-storage-dev libsensor-msgs-dev libstd-msgs-dev liblzf-dev
   # live streams: the Foxglove WebSocket server
   libwebsocketpp-dev libasio-dev
+  # the web viewer: its files are compiled in with xxd; tests load it in headless Chromium
+  xxd chromium
   # estimation, parallel loops, nearest neighbours, geodesy, ray casting for the simulator
   libceres-dev libtbb-dev libnanoflann-dev robin-map-dev libproj-dev proj-data libembree-dev
   # reference implementations (PCL's NDT/GICP) for tests and benchmarks, plots
@@ -39,7 +42,7 @@ done
 
 install_node_tools() {
   local dir
-  for dir in tools/las-check tools/foxglove-check; do
+  for dir in web tools/las-check tools/foxglove-check tools/viewer-check; do
     if [ ! -d "$dir/node_modules" ] || [ "$dir/package-lock.json" -nt "$dir/node_modules" ]; then
       echo "setup: installing the Node.js packages of $dir"
       (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)

@@ -26,6 +26,7 @@ struct RunOptions {
   int threads = -1;  // -1: compute.threads
   std::string registration;
   std::string moving_boxes;
+  std::string view;
 };
 
 // One malloc arena for the whole run. Each loop closure attempt allocates tens of MB for a
@@ -124,7 +125,8 @@ int run(const RunOptions& options) {
                                          .write_ply = options.ply,
                                          .map_voxel_m = options.map_voxel_m,
                                          .realtime = options.realtime,
-                                         .moving_boxes_file = options.moving_boxes};
+                                         .moving_boxes_file = options.moving_boxes,
+                                         .view = options.view};
   if (options.live) {
     std::signal(SIGINT, stopLiveOnSignal);
     std::signal(SIGTERM, stopLiveOnSignal);
@@ -197,6 +199,10 @@ Command addRunCommand(CLI::App& tool) {
   parser->add_flag("--live", options->live,
                    "Run on a live Ouster sensor's UDP packets (configuration section live:) "
                    "instead of a recording, until Ctrl-C or live.idle_timeout_s without a packet");
+  parser->add_option("--view", options->view,
+                     "Serve the web viewer at HOST:PORT while the run goes (open "
+                     "http://HOST:PORT/); the Foxglove channels are on the same port, instead "
+                     "of live.foxglove (docs/viewer.md)");
   parser->add_flag("--ply", options->ply, "Also write map.ply");
   parser
       ->add_option("--threads", options->threads,

@@ -13,7 +13,6 @@
 #include "taiga/geo/coordinates.hpp"
 #include "taiga/georef/georef_files.hpp"
 #include "taiga/io/cloud_files.hpp"
-#include "taiga/io/las_reader.hpp"
 #include "taiga/io/las_writer.hpp"
 #include "taiga/trees/inventory.hpp"
 #include "taiga/trees/tree_files.hpp"
@@ -33,28 +32,13 @@ struct TreesOptions {
 };
 
 PointCloud readCloud(const fs::path& path) {
-  const std::string ext = io::lowercaseExtension(path);
-  if (ext == ".las") {
-    io::LasReader reader(path);
-    PointCloud cloud;
-    reader.read(0, reader.pointCount(), cloud);
-    return cloud;
-  }
-  if (ext == ".laz")
-    throw InputError(fmt::format(
-        "{}: LAZ (compressed LAS) is not read; decompress it first (e.g. `las2las` or `pdal "
-        "translate` to .las) or give a PLY or PCD",
-        path.string()));
-  if (ext == ".ply" || ext == ".pcd") {
-    io::DecodedPoints decoded = io::readPointCloudFile(path, 0.0);
-    if (decoded.dropped_invalid > 0)
-      fmt::print(stderr,
-                 "taiga trees: {}: {} points with NaN, infinite or zero coordinates skipped\n",
-                 path.string(), decoded.dropped_invalid);
-    return std::move(decoded.cloud);
-  }
-  throw InputError(fmt::format("{}: expected a .las, .ply or .pcd point cloud, or a run directory",
-                               path.string()));
+  std::size_t skipped = 0;
+  PointCloud cloud = io::readAnyCloudFile(path, &skipped);
+  if (skipped > 0)
+    fmt::print(stderr,
+               "taiga trees: {}: {} points with NaN, infinite or zero coordinates skipped\n",
+               path.string(), skipped);
+  return cloud;
 }
 
 // Points are shifted to a round offset near them, so projected coordinates (millions of metres)

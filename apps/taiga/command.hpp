@@ -45,5 +45,6 @@ Command addExportMapCommand(CLI::App& tool);
 Command addCalibrateCommand(CLI::App& tool);
 Command addReplayCommand(CLI::App& tool);
 Command addTreesCommand(CLI::App& tool);
+Command addViewCommand(CLI::App& tool);
 
 }  // namespace taiga::app

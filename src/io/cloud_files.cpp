@@ -6,6 +6,7 @@
 #include <cctype>
 
 #include "taiga/core/errors.hpp"
+#include "taiga/io/las_reader.hpp"
 
 namespace taiga::io {
 
@@ -42,6 +43,28 @@ DecodedPoints readPointCloudFile(const std::filesystem::path& path, double stamp
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", path.string(), e.what()));
   }
+}
+
+PointCloud readAnyCloudFile(const std::filesystem::path& path, std::size_t* skipped) {
+  if (skipped) *skipped = 0;
+  const std::string ext = lowercaseExtension(path);
+  if (ext == ".las") {
+    LasReader reader(path);
+    PointCloud cloud;
+    reader.read(0, reader.pointCount(), cloud);
+    return cloud;
+  }
+  if (ext == ".laz")
+    throw InputError(fmt::format(
+        "{}: LAZ (compressed LAS) is not read; decompress it first (e.g. `las2las` or `pdal "
+        "translate` to .las) or give a PLY or PCD",
+        path.string()));
+  if (ext == ".ply" || ext == ".pcd") {
+    DecodedPoints decoded = readPointCloudFile(path, 0.0);
+    if (skipped) *skipped = decoded.dropped_invalid;
+    return std::move(decoded.cloud);
+  }
+  throw InputError(fmt::format("{}: expected a .las, .ply or .pcd point cloud", path.string()));
 }
 
 }  // namespace taiga::io

@@ -82,10 +82,12 @@ std::string pointCloudJson(double t_s, const lie::SE3& T_map_body, const PointCl
 
 }  // namespace
 
-std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_port) {
+std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_port,
+                                                      stream::HttpHandler http) {
   const auto address = udpAddressPort(host_port);
   if (!address)
-    throw InputError(fmt::format("live.foxglove: expected host:port, found '{}'", host_port));
+    throw InputError(fmt::format("{}: expected host:port, found '{}'",
+                                 http ? "--view" : "live.foxglove", host_port));
   return std::make_unique<stream::FoxgloveServer>(
       address->first, address->second,
       std::vector<stream::FoxgloveChannel>{
@@ -93,7 +95,8 @@ std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_po
           {"/taiga/imu_pose", "foxglove.PoseInFrame", kPoseInFrameSchema},
           {"/taiga/scan", "foxglove.PointCloud", kPointCloudSchema},
           {"/taiga/keyframes", "foxglove.PointCloud", kPointCloudSchema},
-          {"/taiga/health", "taiga.ScanHealth", kHealthSchema}});
+          {"/taiga/health", "taiga.ScanHealth", kHealthSchema}},
+      "taiga", 64u << 20, std::move(http));
 }
 
 std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body) {

@@ -27,9 +27,10 @@ enum FoxgloveTopic : std::size_t {
   kHealthTopic
 };
 
-/// The server with the channels above, on "host:port"; InputError naming live.foxglove when the
-/// address is not one or cannot be served.
-std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_port);
+/// The server with the channels above, on "host:port", answering plain HTTP with `http` (the
+/// viewer's page); InputError naming the address when it is not one or cannot be served.
+std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_port,
+                                                      stream::HttpHandler http = {});
 
 /// A foxglove.PoseInFrame message in the map frame.
 std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body);

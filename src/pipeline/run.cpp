@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "foxglove_stream.hpp"
+#include "taiga/view/run_view.hpp"
 #include "online_trees.hpp"
 #include "pose_stream.hpp"
 #include "recording_feed.hpp"
@@ -251,7 +252,11 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   slam.addObserver(gnss);
   std::unique_ptr<stream::FoxgloveServer> foxglove;
   std::optional<FoxgloveMapStream> foxglove_map;
-  if (!config.live.foxglove.empty()) {
+  if (!options.view.empty()) {
+    foxglove = startFoxglove(options.view, view::liveViewResponse);
+    logger().info("viewer on http://{}/", options.view);
+    slam.addObserver(foxglove_map.emplace(*foxglove));
+  } else if (!config.live.foxglove.empty()) {
     foxglove = startFoxglove(config.live.foxglove);
     slam.addObserver(foxglove_map.emplace(*foxglove));
   }

@@ -34,6 +34,7 @@ struct FoxgloveServer::Impl {
   std::vector<FoxgloveChannel> channels;
   std::string name;
   std::size_t max_buffered_bytes = 0;
+  HttpHandler http;
   Server server;
   std::thread thread;
   mutable std::mutex mutex;
@@ -45,6 +46,7 @@ struct FoxgloveServer::Impl {
   void onOpen(Handle client);
   void onClose(Handle client);
   void onMessage(Handle client, Server::message_ptr message);
+  void onHttp(Handle client);
   bool validate(Handle client);
   void sendText(Handle client, const std::string& text);
 };
@@ -124,11 +126,30 @@ void FoxgloveServer::Impl::onMessage(Handle client, Server::message_ptr message)
   }
 }
 
+void FoxgloveServer::Impl::onHttp(Handle client) {
+  Server::connection_ptr connection = server.get_con_from_hdl(client);
+  HttpResponse response{404, "text/plain", "not found\n"};
+  if (connection->get_request().get_method() != "GET") {
+    response = {405, "text/plain", "only GET\n"};
+  } else if (http) {
+    try {
+      response = http(connection->get_resource());
+    } catch (const std::exception& e) {
+      response = {500, "text/plain", std::string(e.what()) + "\n"};
+    }
+  }
+  connection->set_status(static_cast<websocketpp::http::status_code::value>(response.status));
+  connection->replace_header("Content-Type", response.content_type);
+  connection->replace_header("Cache-Control", "no-cache");
+  connection->set_body(std::move(response.body));
+}
+
 FoxgloveServer::FoxgloveServer(const std::string& address, std::uint16_t port,
                                std::vector<FoxgloveChannel> channels, std::string name,
-                               std::size_t max_buffered_bytes)
+                               std::size_t max_buffered_bytes, HttpHandler http)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
+  s.http = std::move(http);
   s.channels = std::move(channels);
   s.name = std::move(name);
   s.max_buffered_bytes = max_buffered_bytes;
@@ -142,6 +163,7 @@ FoxgloveServer::FoxgloveServer(const std::string& address, std::uint16_t port,
   s.server.set_close_handler([&s](Handle h) { s.onClose(h); });
   s.server.set_fail_handler([&s](Handle h) { s.onClose(h); });
   s.server.set_message_handler([&s](Handle h, Server::message_ptr m) { s.onMessage(h, m); });
+  s.server.set_http_handler([&s](Handle h) { s.onHttp(h); });
   websocketpp::lib::error_code error;
   s.server.listen(asio::ip::tcp::endpoint(asio::ip::make_address(address, error), port), error);
   if (!error) s.server.start_accept(error);

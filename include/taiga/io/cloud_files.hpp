@@ -39,6 +39,11 @@ std::string lowercaseExtension(const std::filesystem::path& path);
 DecodedPoints readPointCloudFile(const std::filesystem::path& path, double stamp_s,
                                  const PointDecodeOptions& options = {});
 
+/// Any cloud file a user has: LAS (las_reader.hpp), PLY or PCD, by extension; LAZ is refused with
+/// advice. Points with NaN, infinite or zero coordinates (PLY, PCD) are skipped and counted in
+/// `skipped`. InputError naming the file.
+PointCloud readAnyCloudFile(const std::filesystem::path& path, std::size_t* skipped = nullptr);
+
 /// Writes binary little-endian PLY with x, y, z as float64 (so georeferenced coordinates keep
 /// full precision) and whichever of time (float64, s), intensity (float32), ring and column
 /// (uint16) the cloud carries. CloudCompare, MeshLab and lidR read it.

@@ -47,6 +47,9 @@ struct RunOptions {
   bool show_progress = true;             ///< a progress line on a terminal
   /// Per-scan boxes around moving parts of the rig (io/moving_boxes.hpp); empty: none.
   std::filesystem::path moving_boxes_file;
+  /// "host:port": the web viewer (docs/viewer.md) served there, with the Foxglove channels on
+  /// the same port (instead of live.foxglove); empty: no viewer.
+  std::string view;
 };
 
 /// What a live run would have seen (--realtime): scans dropped because the odometry was behind,

@@ -10,9 +10,13 @@
 // that falls behind by more than max_buffered_bytes gets nothing new until it catches up (the
 // messages in between are dropped for it, and counted).
 //
+// The same port can answer plain HTTP GET requests (the viewer's page and data, view/): a request
+// that is not a WebSocket upgrade goes to the HttpHandler given, if any (404 otherwise).
+//
 // This header is C++17 (its implementation must be compiled as C++17 for websocketpp 0.8).
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +28,15 @@ struct FoxgloveChannel {
   std::string schema_name;  ///< e.g. "foxglove.PoseInFrame"
   std::string schema;       ///< its JSON Schema, as text
 };
+
+struct HttpResponse {
+  int status = 200;
+  std::string content_type = "text/plain";
+  std::string body;
+};
+/// Answers a GET for `resource` (path and query, e.g. "/api/node/3"). Called on the server's
+/// thread; may throw, which answers 500.
+using HttpHandler = std::function<HttpResponse(const std::string& resource)>;
 
 struct FoxgloveServerStats {
   std::uint64_t connections = 0;       ///< clients that connected over the server's life
@@ -37,7 +50,7 @@ class FoxgloveServer {
   /// address when it cannot.
   FoxgloveServer(const std::string& address, std::uint16_t port,
                  std::vector<FoxgloveChannel> channels, std::string name = "taiga",
-                 std::size_t max_buffered_bytes = 64u << 20);
+                 std::size_t max_buffered_bytes = 64u << 20, HttpHandler http = {});
   ~FoxgloveServer();
   FoxgloveServer(const FoxgloveServer&) = delete;
   FoxgloveServer& operator=(const FoxgloveServer&) = delete;
