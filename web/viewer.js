@@ -127,6 +127,12 @@ scene.add(path, keyframeDots, loopLines, poseMarker);
 for (const [id, object] of [["show-path", path], ["show-keyframes", keyframeDots], ["show-loops", loopLines]])
   document.getElementById(id).addEventListener("change", (e) => { object.visible = e.target.checked; requestRender(); });
 
+/// New positions for a geometry; its bounds too, which frustum culling cached when it was empty.
+function setPositions(geometry, xyz) {
+  geometry.setAttribute("position", new THREE.Float32BufferAttribute(xyz, 3));
+  geometry.computeBoundingSphere();
+}
+
 /// Appends a point to a growing line, doubling its buffer when full.
 function appendToLine(line, x, y, z) {
   let attribute = line.geometry.getAttribute("position");
@@ -292,9 +298,9 @@ async function showRun(info) {
   }
   for (const [, x, y, z] of info.trajectory) appendToLine(path, x, y, z);
   state.poses = info.trajectory.length;
-  keyframeGeometry.setAttribute("position", new THREE.Float32BufferAttribute(info.keyframes.flat(), 3));
+  setPositions(keyframeGeometry, info.keyframes.flat());
   state.keyframes = info.keyframes.length;
-  loopLines.geometry.setAttribute("position", new THREE.Float32BufferAttribute(info.loops.flat(2), 3));
+  setPositions(loopLines.geometry, info.loops.flat(2));
 
   lod.nodes = await (await fetch("/api/nodes")).json();
   for (const node of lod.nodes) {
@@ -314,7 +320,7 @@ async function showRun(info) {
 
 // ---- a live run: the Foxglove channels ------------------------------------------------------
 const live = { channels: new Map(), subscriptions: new Map(), keyframeObjects: [], keyframePoints: 0,
-               scanObject: null, ms: [], status: [], zRange: null };
+               scanObject: null, ms: [], status: [], zRange: null, t0: null };
 const liveTopics = ["/taiga/pose", "/taiga/scan", "/taiga/keyframes", "/taiga/health"];
 const decoder = new TextDecoder();
 
@@ -363,7 +369,7 @@ function onLiveMessage(topic, message) {
     }
     const at = message.pose.position;
     const positions = [...(keyframeGeometry.getAttribute("position")?.array ?? []), at.x, at.y, at.z];
-    keyframeGeometry.setAttribute("position", new THREE.Float32BufferAttribute(positions, 3));
+    setPositions(keyframeGeometry, positions);
     ++state.keyframes;
   } else if (topic === "/taiga/scan") {
     if (live.scanObject) { scene.remove(live.scanObject); live.scanObject.geometry.dispose(); }
@@ -377,7 +383,8 @@ function onLiveMessage(topic, message) {
     live.ms.push(message.processing_ms);
     live.status.push(message.status);
     if (live.ms.length > 3000) { live.ms.shift(); live.status.shift(); }
-    setText("health", `scan at ${message.t_s.toFixed(1)} s: <b class="${message.status}">${message.status}</b>` +
+    live.t0 ??= message.t_s;
+    setText("health", `scan at ${(message.t_s - live.t0).toFixed(1)} s: <b class="${message.status}">${message.status}</b>` +
       (message.reason ? ` (${message.reason})` : ""));
     setText("timing", `time per scan: ${message.processing_ms.toFixed(1)} ms, median ${median(live.ms).toFixed(1)} ms`);
     if (state.scans % 5 === 0) drawChart(live.ms, live.status);
