@@ -11,7 +11,7 @@ import { OrbitControls } from "/three/OrbitControls.js";
 
 const state = (window.taigaView = {
   mode: null, ready: false, pointsShown: 0, nodesLoaded: 0, nodesShown: 0, loading: 0,
-  poses: 0, keyframes: 0, scans: 0, messages: 0,
+  poses: 0, keyframes: 0, scans: 0, messages: 0, frames: 0,
 });
 
 // ---- scene ----------------------------------------------------------------------------------
@@ -45,6 +45,7 @@ function frame() {
   if (dirty) {
     dirty = false;
     renderer.render(scene, camera);
+    ++state.frames;
   }
   requestAnimationFrame(frame);
 }
@@ -188,9 +189,9 @@ function showPoints() {
 // ---- a finished run: levels of detail -------------------------------------------------------
 const budgetSelect = document.getElementById("budget");
 const lod = { nodes: [], loaded: new Map(), wanted: [], timer: null };
-/// A node's subsample is one point per 1/64 of its edge: refine it while that spacing covers
-/// more than about 2 pixels (edge on screen > 130 px).
-const kRefinePixels = 130;
+/// A node's subsample is one point per 1/64 of its edge: its children are loaded while that
+/// spacing covers more than 1.5 pixels, i.e. while a child's edge is over 48 pixels on screen.
+const kRefinePixels = 48;
 const kMaxFetches = 4;
 
 function scheduleLod() {

@@ -171,8 +171,9 @@ FoxgloveServer::FoxgloveServer(const std::string& address, std::uint16_t port,
     throw InputError(fmt::format("{}:{}: cannot serve the Foxglove WebSocket there: {}", address,
                                  port, error.message()));
   s.thread = std::thread([&s] { s.server.run(); });
-  logger().info("Foxglove WebSocket on ws://{}:{} ({} channels)", address, this->port(),
-                s.channels.size());
+  if (!s.channels.empty())
+    logger().info("Foxglove WebSocket on ws://{}:{} ({} channels)", address, this->port(),
+                  s.channels.size());
 }
 
 FoxgloveServer::~FoxgloveServer() {

@@ -12,6 +12,7 @@
 #include "taiga/eval/health_split.hpp"
 #include "taiga/eval/timing.hpp"
 #include "taiga/io/cloud_files.hpp"
+#include "taiga/io/las_reader.hpp"
 #include "taiga/io/trajectory_io.hpp"
 #include "taiga/view/web_assets.hpp"
 
@@ -128,7 +129,7 @@ json nodesJson(const LodTree& tree) {
                      {"depth", node.depth},
                      {"parent", node.parent},
                      {"children", children},
-                     {"points", node.points()}});
+                     {"points", node.count}});
   }
   return nodes;
 }
@@ -142,6 +143,25 @@ std::optional<stream::HttpResponse> assetResponse(const std::string& path) {
   const WebAsset* asset = findWebAsset(path == "/index.html" ? "/" : path);
   if (!asset) return std::nullopt;
   return stream::HttpResponse{200, std::string(asset->content_type), std::string(asset->bytes)};
+}
+
+/// The cloud's points for the tree; a LAS file a million points at a time, so a large map is
+/// never held in double precision with all its channels.
+LodPoints readPoints(const fs::path& path) {
+  LodPoints points;
+  if (io::lowercaseExtension(path) != ".las") {
+    points.append(io::readAnyCloudFile(path));
+    return points;
+  }
+  io::LasReader reader(path);
+  constexpr std::uint64_t kChunk = 1u << 20;
+  points.xyzi.reserve(4 * reader.pointCount());
+  for (std::uint64_t first = 0; first < reader.pointCount(); first += kChunk) {
+    PointCloud chunk;
+    reader.read(first, kChunk, chunk);
+    points.append(chunk);
+  }
+  return points;
 }
 
 stream::HttpResponse notFound(const std::string& path) {
@@ -160,7 +180,7 @@ RunView RunView::load(const fs::path& input, const LodOptions& options) {
         input.string()));
   if (!fs::exists(map_path)) throw InputError(fmt::format("{}: no such file", input.string()));
   RunView view;
-  view.tree_ = LodTree::build(io::readAnyCloudFile(map_path), options);
+  view.tree_ = LodTree::build(readPoints(map_path), options);
   if (view.tree_.pointCount() == 0)
     throw InputError(fmt::format("{}: no finite point to show", map_path.string()));
   try {
@@ -184,9 +204,9 @@ stream::HttpResponse RunView::get(const std::string& resource) const {
     const char* last = path.data() + path.size();
     const auto [end, error] = std::from_chars(first, last, id);
     if (error != std::errc() || end != last || id >= tree_.nodes().size()) return notFound(path);
-    const std::vector<float>& xyzi = tree_.nodes()[id].xyzi;
+    const std::span<const float> xyzi = tree_.points(tree_.nodes()[id]);
     return {200, "application/octet-stream",
-            std::string(reinterpret_cast<const char*>(xyzi.data()), xyzi.size() * sizeof(float))};
+            std::string(reinterpret_cast<const char*>(xyzi.data()), xyzi.size_bytes())};
   }
   return notFound(path);
 }

@@ -36,10 +36,11 @@ PointCloud forest(std::size_t points, const Eigen::Vector3d& offset = Eigen::Vec
 
 std::vector<std::tuple<float, float, float, float>> allPoints(const LodTree& tree) {
   std::vector<std::tuple<float, float, float, float>> out;
-  for (const LodNode& node : tree.nodes())
-    for (std::size_t i = 0; i < node.points(); ++i)
-      out.emplace_back(node.xyzi[4 * i], node.xyzi[4 * i + 1], node.xyzi[4 * i + 2],
-                       node.xyzi[4 * i + 3]);
+  for (const LodNode& node : tree.nodes()) {
+    const std::span<const float> xyzi = tree.points(node);
+    for (std::size_t i = 0; i < node.count; ++i)
+      out.emplace_back(xyzi[4 * i], xyzi[4 * i + 1], xyzi[4 * i + 2], xyzi[4 * i + 3]);
+  }
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -60,17 +61,18 @@ TEST(LodTree, EveryPointIsInExactlyOneNodeAndInsideItsCube) {
   EXPECT_EQ(allPoints(tree), expected);
 
   for (const LodNode& node : tree.nodes()) {
-    for (std::size_t i = 0; i < node.points(); ++i) {
+    const std::span<const float> xyzi = tree.points(node);
+    for (std::size_t i = 0; i < node.count; ++i) {
       for (int axis = 0; axis < 3; ++axis) {
-        EXPECT_GE(node.xyzi[4 * i + axis], node.min_m[axis]);
-        EXPECT_LE(node.xyzi[4 * i + axis], node.max_m[axis]);
+        EXPECT_GE(xyzi[4 * i + axis], node.min_m[axis]);
+        EXPECT_LE(xyzi[4 * i + axis], node.max_m[axis]);
       }
     }
     const bool leaf =
         std::all_of(node.children.begin(), node.children.end(), [](int c) { return c < 0; });
     // An inner node keeps at most one point per cell of its grid.
     if (!leaf) {
-      EXPECT_LE(node.points(), 32u * 32u * 32u);
+      EXPECT_LE(node.count, 32u * 32u * 32u);
     }
     for (int c : node.children) {
       if (c < 0) continue;
@@ -90,18 +92,19 @@ TEST(LodTree, EveryPointIsInExactlyOneNodeAndInsideItsCube) {
 TEST(LodTree, TheRootIsAnEvenSubsampleOfTheWholeCloud) {
   const LodTree tree = LodTree::build(forest(200000), {.grid_cells = 64, .leaf_points = 2000});
   const LodNode& root = tree.nodes().front();
-  ASSERT_GT(root.points(), 2000u);
-  ASSERT_LT(root.points(), 100000u);
+  const std::span<const float> xyzi = tree.points(root);
+  ASSERT_GT(root.count, 2000u);
+  ASSERT_LT(root.count, 100000u);
   int quadrants[2][2] = {{0, 0}, {0, 0}};
   double top_m = 0.0;
-  for (std::size_t i = 0; i < root.points(); ++i) {
-    const Eigen::Vector3d p = tree.origin() + Eigen::Vector3d(root.xyzi[4 * i], root.xyzi[4 * i + 1],
-                                                              root.xyzi[4 * i + 2]);
+  for (std::size_t i = 0; i < root.count; ++i) {
+    const Eigen::Vector3d p =
+        tree.origin() + Eigen::Vector3d(xyzi[4 * i], xyzi[4 * i + 1], xyzi[4 * i + 2]);
     ++quadrants[p.x() > 30.0][p.y() > 20.0];
     top_m = std::max(top_m, p.z());
   }
   for (const auto& row : quadrants)
-    for (int count : row) EXPECT_GT(count, static_cast<int>(root.points()) / 8);
+    for (int count : row) EXPECT_GT(count, static_cast<int>(root.count) / 8);
   EXPECT_GT(top_m, 19.0);  // the stems' tops are there
 }
 
@@ -112,10 +115,11 @@ TEST(LodTree, ProjectedCoordinatesKeepMillimetresAndNonFinitePointsAreSkipped) {
   const LodTree tree = LodTree::build(cloud);
   EXPECT_EQ(tree.pointCount(), 5000u);
   const LodNode& root = tree.nodes().front();
-  ASSERT_EQ(root.points(), 5000u);  // fewer than leaf_points: one node keeps them all
-  for (std::size_t i = 0; i < root.points(); ++i) {
-    const Eigen::Vector3d back = tree.origin() + Eigen::Vector3d(root.xyzi[4 * i], root.xyzi[4 * i + 1],
-                                                                 root.xyzi[4 * i + 2]);
+  const std::span<const float> xyzi = tree.points(root);
+  ASSERT_EQ(root.count, 5000u);  // fewer than leaf_points: one node keeps them all
+  for (std::size_t i = 0; i < root.count; ++i) {
+    const Eigen::Vector3d back =
+        tree.origin() + Eigen::Vector3d(xyzi[4 * i], xyzi[4 * i + 1], xyzi[4 * i + 2]);
     EXPECT_LT((back - cloud.positions[i]).norm(), 1e-3);
   }
 }
