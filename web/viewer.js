@@ -3,7 +3,8 @@
 //   and the map as a level-of-detail octree (/api/nodes, /api/node/N), of which the page loads
 //   only the nodes in view that are large on screen, within a point budget;
 // - a live run (`taiga run --view`): the Foxglove WebSocket channels on the same port
-//   (/taiga/pose, /taiga/scan, /taiga/keyframes, /taiga/health; docs/live.md).
+//   (/taiga/pose, /taiga/scan, /taiga/keyframes, /taiga/health, /taiga/keyframe_poses,
+//   /taiga/loops, /taiga/georef; docs/live.md): keyframes move where the mapping graph puts them.
 // The map frame is z-up, in metres; everything is drawn relative to the server's origin.
 // window.taigaView holds counters for tests (tools/viewer-check).
 import * as THREE from "three";
@@ -11,7 +12,7 @@ import { OrbitControls } from "/three/OrbitControls.js";
 
 const state = (window.taigaView = {
   mode: null, ready: false, pointsShown: 0, nodesLoaded: 0, nodesShown: 0, loading: 0,
-  poses: 0, keyframes: 0, scans: 0, messages: 0, frames: 0,
+  poses: 0, keyframes: 0, scans: 0, messages: 0, frames: 0, graphUpdates: 0, loops: 0, georef: 0,
 });
 
 // ---- scene ----------------------------------------------------------------------------------
@@ -288,6 +289,11 @@ async function showRun(info) {
     setText("health", `verdict <b class="${h.verdict}">${h.verdict}</b>: ${h.scans_ok} ok, ` +
       `${h.scans_degraded} degraded, ${h.scans_lost} lost scans`);
   }
+  const g = summary.georef;
+  if (g?.sigma) {
+    setText("georef", `georeferenced in EPSG:${g.epsg} (${g.method}, ${g.inliers} of ${g.fixes} GNSS fixes), ` +
+      `1-sigma ${g.sigma.east_m.toFixed(2)} / ${g.sigma.north_m.toFixed(2)} m, ${g.sigma.yaw_deg.toFixed(1)} deg yaw`);
+  }
   const ms = info.scans.ms, status = info.scans.status;
   state.scans = ms.length;
   if (ms.length > 0) {
@@ -320,9 +326,10 @@ async function showRun(info) {
 }
 
 // ---- a live run: the Foxglove channels ------------------------------------------------------
-const live = { channels: new Map(), subscriptions: new Map(), keyframeObjects: [], keyframePoints: 0,
-               scanObject: null, ms: [], status: [], zRange: null, t0: null };
-const liveTopics = ["/taiga/pose", "/taiga/scan", "/taiga/keyframes", "/taiga/health"];
+const live = { subscriptions: new Map(), keyframes: new Map(), keyframePoints: 0, graph: [],
+               loops: [], scanObject: null, ms: [], status: [], zRange: null, t0: null };
+const liveTopics = ["/taiga/pose", "/taiga/scan", "/taiga/keyframes", "/taiga/health",
+                    "/taiga/keyframe_poses", "/taiga/loops", "/taiga/georef"];
 const decoder = new TextDecoder();
 
 function decodeCloud(message) {
@@ -340,6 +347,51 @@ function placed(object, pose) {
   object.quaternion.set(q.x, q.y, q.z, q.w);
   return object;
 }
+/// A keyframe's pose: the mapping graph's when it has one (loop closures move it), else as
+/// published.
+function keyframePose(id, published) { return live.graph[id] ?? published; }
+
+/// Keyframe dots and loop lines from the keyframes' current poses.
+function drawGraph() {
+  const at = [];
+  for (const [id, object] of [...live.keyframes].sort((a, b) => a[0] - b[0])) {
+    placed(object, keyframePose(id, object.userData.published));
+    at.push(object.position.x, object.position.y, object.position.z);
+  }
+  setPositions(keyframeGeometry, at);
+  const lines = [];
+  for (const [a, b] of live.loops) {
+    const pa = live.graph[a]?.position, pb = live.graph[b]?.position;
+    if (pa && pb) lines.push(pa.x, pa.y, pa.z, pb.x, pb.y, pb.z);
+  }
+  setPositions(loopLines.geometry, lines);
+}
+
+function onKeyframe(message) {
+  const xyzi = decodeCloud(message);
+  if (!live.zRange) {
+    colourRange.height = robustRange(xyzi, 2);
+    colourRange.intensity = [0, robustRange(xyzi, 3)[1]];
+    live.zRange = true;
+  }
+  // Heights are coloured in the map frame: the body frame's z shifted by the pose's height
+  // (exact for a level body, which a forest walk nearly is).
+  const object = pointsObject(xyzi, message.pose.position.z);
+  object.userData.published = message.pose;
+  mapGroup.add(object);
+  live.keyframes.set(message.keyframe ?? live.keyframes.size, object);
+  live.keyframePoints += xyzi.length / 4;
+  // The oldest keyframes go when the budget is spent.
+  while (live.keyframePoints > Number(budgetSelect.value) && live.keyframes.size > 1) {
+    const [oldest, old] = live.keyframes.entries().next().value;
+    mapGroup.remove(old);
+    old.geometry.dispose();
+    live.keyframes.delete(oldest);
+    live.keyframePoints -= old.userData.xyzi.length / 4;
+  }
+  ++state.keyframes;
+  drawGraph();
+}
 
 function onLiveMessage(topic, message) {
   ++state.messages;
@@ -349,29 +401,20 @@ function onLiveMessage(topic, message) {
     placed(poseMarker, message.pose).visible = true;
     if (state.poses++ === 0) lookAt(new THREE.Vector3(p.x, p.y, p.z), 25);
   } else if (topic === "/taiga/keyframes") {
-    const xyzi = decodeCloud(message);
-    if (!live.zRange) {
-      colourRange.height = robustRange(xyzi, 2);
-      colourRange.intensity = [0, robustRange(xyzi, 3)[1]];
-    }
-    // Heights are coloured in the map frame: the body frame's z shifted by the pose's height
-    // (exact for a level body, which a forest walk nearly is).
-    const object = placed(pointsObject(xyzi, message.pose.position.z), message.pose);
-    live.zRange = true;
-    mapGroup.add(object);
-    live.keyframeObjects.push(object);
-    live.keyframePoints += xyzi.length / 4;
-    // The oldest keyframes go when the budget is spent.
-    while (live.keyframePoints > Number(budgetSelect.value) && live.keyframeObjects.length > 1) {
-      const old = live.keyframeObjects.shift();
-      mapGroup.remove(old);
-      old.geometry.dispose();
-      live.keyframePoints -= old.userData.xyzi.length / 4;
-    }
-    const at = message.pose.position;
-    const positions = [...(keyframeGeometry.getAttribute("position")?.array ?? []), at.x, at.y, at.z];
-    setPositions(keyframeGeometry, positions);
-    ++state.keyframes;
+    onKeyframe(message);
+  } else if (topic === "/taiga/keyframe_poses") {
+    live.graph = message.poses;
+    ++state.graphUpdates;
+    drawGraph();
+  } else if (topic === "/taiga/loops") {
+    live.loops.push([message.keyframe, message.candidate]);
+    state.loops = live.loops.length;
+    drawGraph();
+  } else if (topic === "/taiga/georef") {
+    ++state.georef;
+    const [e, n] = message.sigma;
+    setText("georef", `EPSG:${message.epsg} E ${message.easting_m.toFixed(1)} N ${message.northing_m.toFixed(1)} m, ` +
+      `1-sigma ${e.toFixed(2)} / ${n.toFixed(2)} m (${message.fixes} GNSS fixes)`);
   } else if (topic === "/taiga/scan") {
     if (live.scanObject) { scene.remove(live.scanObject); live.scanObject.geometry.dispose(); }
     const xyzi = decodeCloud(message);

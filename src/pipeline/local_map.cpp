@@ -131,6 +131,9 @@ std::vector<const registration::NdtTarget*> LocalMap::ndtTargets() const {
   return targets;
 }
 const registration::KdTree& LocalMap::kdTree() const { return inUse(in_use_.kd_tree, "kd-tree"); }
+const std::vector<Eigen::Vector3d>* LocalMap::pointsInUse() const {
+  return in_use_.kd_tree ? &in_use_.kd_tree->points() : nullptr;
+}
 const registration::Occupancy& LocalMap::occupancy(double voxel_m) const {
   if (!in_use_.occupancy || in_use_.occupancy_voxel_m != voxel_m) {
     in_use_.occupancy = std::make_unique<registration::Occupancy>(kdTree().points(), voxel_m);

@@ -255,10 +255,10 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   if (!options.view.empty()) {
     foxglove = startFoxglove(options.view, view::liveViewResponse);
     logger().info("viewer on http://{}/", options.view);
-    slam.addObserver(foxglove_map.emplace(*foxglove));
+    slam.addObserver(foxglove_map.emplace(*foxglove, slam.odometry(), &gnss));
   } else if (!config.live.foxglove.empty()) {
     foxglove = startFoxglove(config.live.foxglove);
-    slam.addObserver(foxglove_map.emplace(*foxglove));
+    slam.addObserver(foxglove_map.emplace(*foxglove, slam.odometry(), &gnss));
   }
   std::optional<PoseStream> pose_stream;
   if (!config.live.pose_udp.empty() || foxglove) {

@@ -36,18 +36,6 @@ GeorefRunReport georeferenceRun(const Trajectory& trajectory, const georef::Gnss
 
 class GnssRecorder final : public SlamObserver {
  public:
-  explicit GnssRecorder(const SystemConfig& config);
-
-  void onImu(const ImuSample& sample) override;
-  void onGnssFix(const GnssFix& fix) override;
-  void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
-
-  const georef::GnssInput& input() const { return gnss_; }
-  /// DIR/trajectory_online_epsgNNNN.csv: one row per scan from the first online estimate on;
-  /// nothing when there was none.
-  void writeOnline(const std::filesystem::path& dir) const;
-
- private:
   /// A scan's pose in the grid as the online georeferencer gave it when the scan was published.
   struct OnlineGridPose {
     georef::GridPose pose;
@@ -55,6 +43,25 @@ class GnssRecorder final : public SlamObserver {
     std::size_t fixes = 0;              ///< fixes the estimate used
   };
 
+  explicit GnssRecorder(const SystemConfig& config);
+
+  void onImu(const ImuSample& sample) override;
+  void onGnssFix(const GnssFix& fix) override;
+  void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
+
+  const georef::GnssInput& input() const { return gnss_; }
+  int epsg() const { return config_.epsg; }
+  /// The scan at `t_s` in the grid, if it was the last one published and the online
+  /// georeference had an estimate for it.
+  const OnlineGridPose* onlinePoseAt(double t_s) const {
+    return !online_poses_.empty() && online_poses_.back().pose.t_s == t_s ? &online_poses_.back()
+                                                                           : nullptr;
+  }
+  /// DIR/trajectory_online_epsgNNNN.csv: one row per scan from the first online estimate on;
+  /// nothing when there was none.
+  void writeOnline(const std::filesystem::path& dir) const;
+
+ private:
   GeorefConfig config_;
   bool keep_imu_orientation_;
   georef::GnssInput gnss_{.from_recording = true};

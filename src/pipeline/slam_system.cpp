@@ -11,17 +11,18 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-mapping::MappingThreadOptions mappingThreadOptions(const SystemConfig& config,
-                                                   const SlamOptions& options,
-                                                   const mapping::KeyframeStore& store) {
+mapping::MappingThreadOptions mappingThreadOptions(
+    const SystemConfig& config, const SlamOptions& options, const mapping::KeyframeStore& store,
+    const std::vector<SlamObserver*>& observers) {
   mapping::MappingThreadOptions out;
   // The snapshots the odometry follows (step 11), as many as its local map holds.
   if (config.mapping.correct_odometry)
     out.snapshot_keyframes = static_cast<std::size_t>(config.odometry.local_map_keyframes);
-  if (options.live_keyframe_poses)
-    out.after_keyframe = [&store](const mapping::Mapper& mapper) {
-      store.writePoses(mapper.keyframeTrajectory());
-    };
+  out.after_keyframe = [&store, &observers,
+                        write_poses = options.live_keyframe_poses](const mapping::Mapper& mapper) {
+    if (write_poses) store.writePoses(mapper.keyframeTrajectory());
+    for (SlamObserver* observer : observers) observer->onGraph(mapper);
+  };
   return out;
 }
 
@@ -44,7 +45,7 @@ SlamSystem::SlamSystem(const SystemConfig& config, SlamOptions options)
            .registration_voxel_point =
                preprocess::voxelRepresentative(config.odometry.voxel_point)})),
       mapping_thread_(config.mapping, config.odometry, store_,
-                      mappingThreadOptions(config, options, store_)),
+                      mappingThreadOptions(config, options, store_, observers_)),
       correction_(std::make_unique<OdometryCorrection>(
           static_cast<std::size_t>(config.odometry.local_map_keyframes))) {
   odometry_.setMovingBoxes(std::move(options.moving_boxes_body));

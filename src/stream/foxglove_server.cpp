@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <atomic>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -41,6 +42,14 @@ struct FoxgloveServer::Impl {
   /// Per client: subscription id by channel index.
   std::map<Handle, std::map<std::size_t, std::uint32_t>, std::owner_less<Handle>> clients;
   std::vector<int> subscribers;  ///< per channel
+  struct KeptMessage {
+    std::uint64_t t_ns;
+    std::string json;
+  };
+  /// Per channel, what a late subscriber gets first (publish()'s `keep`).
+  std::vector<std::deque<KeptMessage>> history;
+  std::vector<std::size_t> history_bytes;
+  std::size_t max_history_bytes = 0;
   FoxgloveServerStats stats;
 
   void onOpen(Handle client);
@@ -49,7 +58,31 @@ struct FoxgloveServer::Impl {
   void onHttp(Handle client);
   bool validate(Handle client);
   void sendText(Handle client, const std::string& text);
+  /// A Message Data frame to one client, unless it is too far behind (counted) and this is not
+  /// the history it subscribed to (`kept`: bounded by max_history_bytes). Under `mutex`.
+  void sendMessage(Handle client, std::uint32_t subscription, std::uint64_t t_ns,
+                   const std::string& json, bool kept = false);
 };
+
+void FoxgloveServer::Impl::sendMessage(Handle client, std::uint32_t subscription,
+                                       std::uint64_t t_ns, const std::string& json,
+                                       bool kept) {
+  websocketpp::lib::error_code error;
+  Server::connection_ptr connection = server.get_con_from_hdl(client, error);
+  if (error) return;
+  if (!kept && connection->get_buffered_amount() > max_buffered_bytes) {
+    ++stats.messages_dropped;
+    return;
+  }
+  std::string frame;
+  frame.reserve(13 + json.size());
+  frame.push_back(static_cast<char>(kMessageDataOpcode));
+  putLe(frame, subscription, 4);
+  putLe(frame, t_ns, 8);
+  frame += json;
+  connection->send(frame, websocketpp::frame::opcode::binary);
+  ++stats.messages_sent;
+}
 
 bool FoxgloveServer::Impl::validate(Handle client) {
   Server::connection_ptr connection = server.get_con_from_hdl(client);
@@ -109,8 +142,11 @@ void FoxgloveServer::Impl::onMessage(Handle client, Server::message_ptr message)
       for (const nlohmann::json& s : request.at("subscriptions")) {
         const auto channel = s.at("channelId").get<std::size_t>();
         if (channel == 0 || channel > channels.size()) continue;
-        if (subscriptions.emplace(channel - 1, s.at("id").get<std::uint32_t>()).second)
-          ++subscribers[channel - 1];
+        const auto id = s.at("id").get<std::uint32_t>();
+        if (!subscriptions.emplace(channel - 1, id).second) continue;
+        ++subscribers[channel - 1];
+        for (const KeptMessage& kept : history[channel - 1])
+          sendMessage(client, id, kept.t_ns, kept.json, true);
       }
     } else if (request["op"] == "unsubscribe") {
       for (const nlohmann::json& id : request.at("subscriptionIds")) {
@@ -146,14 +182,18 @@ void FoxgloveServer::Impl::onHttp(Handle client) {
 
 FoxgloveServer::FoxgloveServer(const std::string& address, std::uint16_t port,
                                std::vector<FoxgloveChannel> channels, std::string name,
-                               std::size_t max_buffered_bytes, HttpHandler http)
+                               std::size_t max_buffered_bytes, HttpHandler http,
+                               std::size_t max_history_bytes)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.http = std::move(http);
+  s.max_history_bytes = max_history_bytes;
   s.channels = std::move(channels);
   s.name = std::move(name);
   s.max_buffered_bytes = max_buffered_bytes;
   s.subscribers.assign(s.channels.size(), 0);
+  s.history.resize(s.channels.size());
+  s.history_bytes.assign(s.channels.size(), 0);
   s.server.clear_access_channels(websocketpp::log::alevel::all);
   s.server.clear_error_channels(websocketpp::log::elevel::all);
   s.server.init_asio();
@@ -202,27 +242,30 @@ bool FoxgloveServer::subscribed(std::size_t channel) const {
   return channel < impl_->subscribers.size() && impl_->subscribers[channel] > 0;
 }
 
-void FoxgloveServer::publish(std::size_t channel, std::uint64_t t_ns, const std::string& json) {
+void FoxgloveServer::publish(std::size_t channel, std::uint64_t t_ns, const std::string& json,
+                             const Kept* keep) {
   Impl& s = *impl_;
   std::lock_guard lock(s.mutex);
-  for (const auto& [client, subscriptions] : s.clients) {
-    const auto it = subscriptions.find(channel);
-    if (it == subscriptions.end()) continue;
-    websocketpp::lib::error_code error;
-    Server::connection_ptr connection = s.server.get_con_from_hdl(client, error);
-    if (error) continue;
-    if (connection->get_buffered_amount() > s.max_buffered_bytes) {
-      ++s.stats.messages_dropped;
-      continue;
+  const std::string& sent = json.empty() && keep ? keep->json : json;
+  if (!sent.empty()) {
+    for (const auto& [client, subscriptions] : s.clients) {
+      const auto it = subscriptions.find(channel);
+      if (it != subscriptions.end()) s.sendMessage(client, it->second, t_ns, sent);
     }
-    std::string frame;
-    frame.reserve(13 + json.size());
-    frame.push_back(static_cast<char>(kMessageDataOpcode));
-    putLe(frame, it->second, 4);
-    putLe(frame, t_ns, 8);
-    frame += json;
-    connection->send(frame, websocketpp::frame::opcode::binary);
-    ++s.stats.messages_sent;
+  }
+  if (!keep) return;
+  std::deque<Impl::KeptMessage>& kept = s.history.at(channel);
+  std::size_t& bytes = s.history_bytes[channel];
+  if (keep->replace) {
+    kept.clear();
+    bytes = 0;
+  }
+  kept.push_back({t_ns, keep->json});
+  bytes += keep->json.size();
+  while (bytes > s.max_history_bytes && kept.size() > 1) {
+    bytes -= kept.front().json.size();
+    kept.pop_front();
+    ++s.stats.history_dropped;
   }
 }
 

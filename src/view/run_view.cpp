@@ -90,7 +90,7 @@ json summaryJson(const fs::path& path) {
   if (!summary.is_object()) return json::object();
   json out = json::object();
   for (const char* key : {"health", "time_per_scan_ms", "realtime_factor", "keyframes",
-                          "loop_closures", "path_length_m", "duration_s"})
+                          "loop_closures", "path_length_m", "duration_s", "georef"})
     if (summary.contains(key)) out[key] = summary[key];
   return out;
 }

@@ -231,10 +231,108 @@ TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
   for (const nlohmann::json& s : scans) EXPECT_GT(s["points"].get<double>(), 500.0);
   const nlohmann::json& keyframes = topics["/taiga/keyframes"]["messages"];
   EXPECT_GE(keyframes.size(), 3u);
-  for (const nlohmann::json& k : keyframes) EXPECT_GT(k["points"].get<double>(), 1000.0);
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    EXPECT_GT(keyframes[k]["points"].get<double>(), 1000.0);
+    EXPECT_EQ(keyframes[k]["keyframe"], k);
+  }
   const nlohmann::json& health = topics["/taiga/health"]["messages"];
   EXPECT_EQ(health.size(), online.size());
   for (const nlohmann::json& h : health) EXPECT_EQ(h["status"], "ok");
+}
+
+// A client that connects while a run goes gets the map so far (every keyframe once, in order),
+// the mapping graph's keyframe poses after each keyframe, its loop closures, and from then on the
+// online georeference: here a recording with GNSS fixes, run from the file at full speed, whose
+// walk closes its loop.
+TEST(LiveCli, AFoxgloveClientThatJoinsLateGetsTheMapTheGraphLoopsAndGeoreference) {
+  test::TempDir dir;
+  const auto sim = dir.file("sim");
+  ASSERT_EQ(test::runTaiga("simulate --scenario handheld-loop --duration 30 --beams 32 --columns "
+                           "512 --seed 4 --out " +
+                           sim.string())
+                .exit_code,
+            0);
+  const int ws_port = 7505 + portOffset();
+  YAML::Node config = YAML::LoadFile((sim / "rig.yaml").string());
+  config["live"]["foxglove"] = fmt::format("127.0.0.1:{}", ws_port);
+  const auto config_path = dir.write("foxglove.yaml", YAML::Dump(config) + "\n");
+  auto client = std::async(std::launch::async, [&] {
+    return test::runCommand(fmt::format(
+        "node tools/foxglove-check/foxglove-check.mjs ws://127.0.0.1:{} 60 2>&1", ws_port));
+  });
+  const auto out = sim / "run";
+  const test::TaigaResult run =
+      test::runTaiga(fmt::format("run {} --config {} --out {}", (sim / "recording.bag").string(),
+                                 config_path.string(), out.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const test::TaigaResult received = client.get();
+  ASSERT_EQ(received.exit_code, 0) << received.output << " (run scripts/setup.sh)";
+  const nlohmann::json topics = nlohmann::json::parse(received.output)["topics"];
+
+  const auto keyframes_tum = tumPositions(out / "keyframes.tum");
+  const nlohmann::json& keyframes = topics["/taiga/keyframes"]["messages"];
+  ASSERT_EQ(keyframes.size(), keyframes_tum.size());
+  for (std::size_t k = 0; k < keyframes.size(); ++k) EXPECT_EQ(keyframes[k]["keyframe"], k);
+
+  // The local map at the keyframes after the client subscribed.
+  const nlohmann::json& local_maps = topics["/taiga/local_map"]["messages"];
+  ASSERT_FALSE(local_maps.empty());
+  for (const nlohmann::json& m : local_maps) EXPECT_GT(m["points"].get<double>(), 1000.0);
+
+  // The graph's last poses are the final keyframe poses (keyframes.tum).
+  const nlohmann::json& graphs = topics["/taiga/keyframe_poses"]["messages"];
+  ASSERT_FALSE(graphs.empty());
+  EXPECT_EQ(topics["/taiga/keyframe_poses"]["schemaName"], "foxglove.PosesInFrame");
+  const nlohmann::json& poses = graphs.back()["poses"];
+  ASSERT_EQ(poses.size(), keyframes_tum.size());
+  std::size_t k = 0;
+  for (const auto& [t, p_final] : keyframes_tum) {
+    const nlohmann::json& p = poses[k++]["position"];
+    EXPECT_LT((p_final - Eigen::Vector3d(p["x"], p["y"], p["z"])).norm(), 0.01) << k;
+  }
+
+  // Every accepted loop closure of loops.csv, as keyframe pairs.
+  std::vector<std::pair<int, int>> accepted;
+  std::ifstream loops_csv(out / "loops.csv");
+  std::string line;
+  std::getline(loops_csv, line);
+  while (std::getline(loops_csv, line)) {
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+    if (fields.at(9) == "1") accepted.emplace_back(std::stoi(fields[1]), std::stoi(fields[2]));
+  }
+  ASSERT_GE(accepted.size(), 1u) << "the walk closes its loop";
+  const nlohmann::json& loops = topics["/taiga/loops"]["messages"];
+  ASSERT_EQ(loops.size(), accepted.size());
+  for (std::size_t i = 0; i < loops.size(); ++i) {
+    EXPECT_EQ(loops[i]["keyframe"], accepted[i].first);
+    EXPECT_EQ(loops[i]["candidate"], accepted[i].second);
+  }
+
+  // The online georeference in the grid and as latitude and longitude (the simulator's forest
+  // is in Finland), the last one as georef/trajectory_online_epsg3067.csv has it.
+  const nlohmann::json& grid = topics["/taiga/georef"]["messages"];
+  const nlohmann::json& fixes = topics["/taiga/fix"]["messages"];
+  ASSERT_GT(grid.size(), 50u);
+  ASSERT_EQ(fixes.size(), grid.size());
+  for (const nlohmann::json& f : fixes) {
+    EXPECT_GT(f["latitude"].get<double>(), 59.5);
+    EXPECT_LT(f["latitude"].get<double>(), 70.5);
+    EXPECT_GT(f["longitude"].get<double>(), 19.0);
+    EXPECT_LT(f["longitude"].get<double>(), 32.0);
+    EXPECT_EQ(f["position_covariance_type"], 2);
+  }
+  std::ifstream online_csv(out / "georef" / "trajectory_online_epsg3067.csv");
+  std::string last;
+  while (std::getline(online_csv, line)) last = line;
+  std::stringstream row(last);
+  std::string t_field, easting_field;
+  std::getline(row, t_field, ',');
+  std::getline(row, easting_field, ',');
+  EXPECT_EQ(grid.back()["epsg"], 3067);
+  EXPECT_NEAR(grid.back()["t_s"].get<double>(), std::stod(t_field), 1e-5);
+  EXPECT_NEAR(grid.back()["easting_m"].get<double>(), std::stod(easting_field), 1e-3);
 }
 
 // The packets of one sensor configuration, and metadata that describes another profile or

@@ -129,6 +129,7 @@ TEST(ViewCli, TheViewerFollowsALiveRun) {
   EXPECT_GT(report["state"]["poses"].get<int>(), 5);
   EXPECT_GT(report["state"]["keyframes"].get<int>(), 0);
   EXPECT_GT(report["state"]["scans"].get<int>(), 5);
+  EXPECT_GT(report["state"]["graphUpdates"].get<int>(), 0);  // keyframes placed by the graph
 }
 
 TEST(ViewCli, WhatCannotBeServedIsNamed) {

@@ -2,7 +2,7 @@
 // (@foxglove/ws-protocol): connects (retrying until the server is up), subscribes to every
 // advertised channel, and when the server closes the connection (or after TIMEOUT_S) prints one
 // JSON object: per topic, the schema name, the number of messages and their decoded JSON
-// (poses in full; point clouds as their point count and pose).
+// (poses in full; point clouds as their point count, pose and keyframe id).
 // Usage: node foxglove-check.mjs ws://HOST:PORT [TIMEOUT_S]
 import wsProtocol from "@foxglove/ws-protocol";
 import WebSocket from "ws";
@@ -19,7 +19,8 @@ const decoder = new TextDecoder();
 function summarize(topic, message) {
   if (message.data === undefined) return message;
   const bytes = Buffer.from(message.data, "base64").length;
-  return { timestamp: message.timestamp, pose: message.pose, points: bytes / message.point_stride };
+  return { timestamp: message.timestamp, pose: message.pose, keyframe: message.keyframe,
+           points: bytes / message.point_stride };
 }
 
 let finished = false;

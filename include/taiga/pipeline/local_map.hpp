@@ -67,6 +67,9 @@ class LocalMap {
   /// The structures in use (logic_error for the other target's); the NDT targets coarse to fine.
   std::vector<const registration::NdtTarget*> ndtTargets() const;
   const registration::KdTree& kdTree() const;
+  /// The points the registration searches now (one per point_spacing_m voxel, odom frame), or
+  /// nullptr before the first build: what a viewer shows as the local map.
+  const std::vector<Eigen::Vector3d>* pointsInUse() const;
   const registration::GicpCloud& gicpCloud() const;
   /// The voxels (of edge voxel_m) that the kd-tree's points occupy, for the correlative search;
   /// built at the first call on the structures in use (none is built for maps never searched).

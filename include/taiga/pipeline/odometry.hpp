@@ -134,6 +134,8 @@ class Odometry {
     local_map_.repose(T_odom_keyframe_at);
   }
   const std::string& initializationNote() const;
+  /// The local map the scans are registered to (between scans, on the odometry's thread).
+  const LocalMap& localMap() const { return local_map_; }
 
  private:
   std::optional<ScanOutcome> processScan(const io::Scan& scan);

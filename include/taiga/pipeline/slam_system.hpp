@@ -45,6 +45,9 @@ class SlamObserver {
   virtual void onKeyframe(std::uint64_t /*id*/, const ScanOutcome& /*scan*/) {}
   /// The odometry rebuilt its local map in the shape the graph gave it.
   virtual void onLocalMapRebuilt() {}
+  /// The mapping graph after it handled a keyframe (its keyframe poses, loop closures). Called
+  /// on the mapping thread, not the main thread: an observer that shares state must lock.
+  virtual void onGraph(const mapping::Mapper& /*mapper*/) {}
   virtual void onGnssFix(const GnssFix& /*fix*/) {}
   virtual void onImu(const ImuSample& /*sample*/) {}
 };
@@ -65,7 +68,8 @@ class SlamSystem {
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
 
-  /// Observers are told in the order they were added; they must outlive the system's input.
+  /// Observers are told in the order they were added; they must be added before the first input
+  /// (the mapping thread reads the list) and outlive it.
   void addObserver(SlamObserver& observer) { observers_.push_back(&observer); }
   void add(const io::RecordingEvent& event);
   void add(const ImuSample& sample);

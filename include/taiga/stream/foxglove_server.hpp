@@ -42,6 +42,7 @@ struct FoxgloveServerStats {
   std::uint64_t connections = 0;       ///< clients that connected over the server's life
   std::uint64_t messages_sent = 0;     ///< Message Data frames sent
   std::uint64_t messages_dropped = 0;  ///< not sent to a client that was too far behind
+  std::uint64_t history_dropped = 0;   ///< kept messages dropped for max_history_bytes
 };
 
 class FoxgloveServer {
@@ -50,14 +51,26 @@ class FoxgloveServer {
   /// address when it cannot.
   FoxgloveServer(const std::string& address, std::uint16_t port,
                  std::vector<FoxgloveChannel> channels, std::string name = "taiga",
-                 std::size_t max_buffered_bytes = 64u << 20, HttpHandler http = {});
+                 std::size_t max_buffered_bytes = 64u << 20, HttpHandler http = {},
+                 std::size_t max_history_bytes = 256u << 20);
   ~FoxgloveServer();
   FoxgloveServer(const FoxgloveServer&) = delete;
   FoxgloveServer& operator=(const FoxgloveServer&) = delete;
 
   std::uint16_t port() const;
-  /// Sends `json` on channel `channel` (index into the channels given) to its subscribers.
-  void publish(std::size_t channel, std::uint64_t t_ns, const std::string& json);
+  /// What a client that subscribes later gets of a message, before anything new: `json` (e.g. a
+  /// thinner copy), added to the channel's kept messages (a history, such as the map's
+  /// keyframes; the oldest dropped beyond max_history_bytes per channel, counted) or, with
+  /// `replace`, in their place (a state, such as the latest keyframe poses).
+  struct Kept {
+    std::string json;
+    bool replace = false;
+  };
+  /// Sends `json` on channel `channel` (index into the channels given) to its subscribers, and
+  /// keeps `keep` for later ones, atomically: no subscriber misses the message or gets it twice.
+  /// An empty `json` (nobody was subscribed when it would have been built) sends `keep->json`.
+  void publish(std::size_t channel, std::uint64_t t_ns, const std::string& json,
+               const Kept* keep = nullptr);
   /// Whether any client subscribed to `channel` (to skip building messages nobody wants).
   bool subscribed(std::size_t channel) const;
   FoxgloveServerStats stats() const;
