@@ -13,6 +13,7 @@ import { OrbitControls } from "/three/OrbitControls.js";
 const state = (window.taigaView = {
   mode: null, ready: false, pointsShown: 0, nodesLoaded: 0, nodesShown: 0, loading: 0,
   poses: 0, keyframes: 0, scans: 0, messages: 0, frames: 0, graphUpdates: 0, loops: 0, georef: 0,
+  trees: 0,
 });
 
 // ---- scene ----------------------------------------------------------------------------------
@@ -133,6 +134,30 @@ for (const [id, object] of [["show-path", path], ["show-keyframes", keyframeDots
 function setPositions(geometry, xyz) {
   geometry.setAttribute("position", new THREE.Float32BufferAttribute(xyz, 3));
   geometry.computeBoundingSphere();
+}
+
+// Trees (trees.csv of `taiga trees` or `mapping.trees`): each stem a cylinder of its DBH from the
+// ground to 3 m (around breast height; a full-height column would hide the map), coloured by DBH.
+const trees = new THREE.Group();
+scene.add(trees);
+document.getElementById("show-trees").addEventListener("change", (e) => { trees.visible = e.target.checked; requestRender(); });
+function showTrees(rows) {
+  if (rows.length === 0) return;
+  const stem = new THREE.CylinderGeometry(0.5, 0.5, 1, 12);
+  stem.rotateX(Math.PI / 2);  // along z
+  stem.translate(0, 0, 0.5);  // from its base
+  const mesh = new THREE.InstancedMesh(stem, new THREE.MeshBasicMaterial(), rows.length);
+  const maxDbh = Math.max(...rows.map((t) => t[3]));
+  const matrix = new THREE.Matrix4(), colour = new Float32Array(3);
+  rows.forEach(([x, y, z, dbh], i) => {
+    matrix.makeScale(dbh, dbh, 3).setPosition(x, y, z ?? 0);
+    mesh.setMatrixAt(i, matrix);
+    rampColour(dbh / maxDbh, colour, 0);
+    mesh.setColorAt(i, new THREE.Color(0.55 + 0.45 * colour[0], 0.35 + 0.3 * colour[1], 0.2));
+  });
+  mesh.computeBoundingSphere();
+  trees.add(mesh);
+  state.trees = rows.length;
 }
 
 /// Appends a point to a growing line, doubling its buffer when full.
@@ -304,6 +329,7 @@ async function showRun(info) {
     drawChart(ms, status);
   }
   for (const [, x, y, z] of info.trajectory) appendToLine(path, x, y, z);
+  showTrees(info.trees ?? []);
   state.poses = info.trajectory.length;
   setPositions(keyframeGeometry, info.keyframes.flat());
   state.keyframes = info.keyframes.length;

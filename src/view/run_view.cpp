@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -14,6 +15,7 @@
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/io/las_reader.hpp"
 #include "taiga/io/trajectory_io.hpp"
+#include "taiga/trees/tree_files.hpp"
 #include "taiga/view/web_assets.hpp"
 
 namespace taiga::view {
@@ -83,6 +85,19 @@ json scansJson(const fs::path& dir) {
   return out;
 }
 
+/// trees.csv (`taiga trees`, or `mapping.trees` in a run): [x, y, ground z, DBH, height] per
+/// stem at breast height; NaN fields (a file without heights) as null.
+json treesJson(const fs::path& path, const Eigen::Vector3d& origin) {
+  json out = json::array();
+  if (!fs::exists(path)) return out;
+  for (const trees::TreeRecord& t : trees::readTreesCsv(path)) {
+    const Eigen::Vector3d p = Eigen::Vector3d(t.bh_xy_m.x(), t.bh_xy_m.y(), t.ground_z_m) - origin;
+    const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    out.push_back({p.x(), p.y(), number(p.z()), t.dbh_m, number(t.height_m)});
+  }
+  return out;
+}
+
 json summaryJson(const fs::path& path) {
   if (!fs::exists(path)) return json::object();
   std::ifstream in(path);
@@ -105,6 +120,7 @@ json infoJson(const fs::path& input, bool run_dir, const LodTree& tree) {
                {"keyframes", json::array()},
                {"loops", json::array()},
                {"scans", scansJson(run_dir ? input : fs::path())},
+               {"trees", treesJson((run_dir ? input : input.parent_path()) / "trees.csv", origin)},
                {"summary", json::object()}};
   if (!run_dir) return info;
   info["trajectory"] = trajectoryJson(input / "trajectory.tum", origin);

@@ -45,6 +45,8 @@ std::filesystem::path writeRun(const test::TempDir& dir) {
       << "10.2,2,1,1.0,5.0,0.50,0.01,0.1,1.0,0,\"fitness\"\n";
   std::ofstream(run / "timing.csv") << "t_s,read_ms,total_ms\n10.0,1,5.5\n10.1,1,6.5\n10.2,1,40\n10.3,1,7\n";
   std::ofstream(run / "scans.csv") << "t_s,status\n10.0,ok\n10.1,ok\n10.2,degraded\n10.3,ok\n";
+  std::ofstream(run / "trees.csv") << "id,x_m,y_m,z_m,dbh_m\n1,1005.0,2000.5,0.1,0.25\n"
+                                    << "2,1010.0,2001.0,0.2,0.31\n";
   std::ofstream(run / "summary.json")
       << R"({"health": {"verdict": "ok", "scans_ok": 3}, "time_per_scan_ms": {"p50": 6.0},
             "realtime_factor": 9.5, "recording": "not passed on"})";
@@ -89,6 +91,9 @@ TEST(RunView, InfoHasTheWalkKeyframesAcceptedLoopsAndScansRelativeToTheOrigin) {
   EXPECT_EQ(info["summary"]["health"]["verdict"], "ok");
   EXPECT_EQ(info["summary"]["realtime_factor"], 9.5);
   EXPECT_FALSE(info["summary"].contains("recording"));
+  ASSERT_EQ(info["trees"].size(), 2u);  // x, y, ground z, DBH, height (none in this file)
+  EXPECT_EQ(info["trees"][0], nlohmann::json::parse("[5.0, 0.5, 0.1, 0.25, null]"));
+  EXPECT_NEAR(info["trees"][1][3].get<double>(), 0.31, 1e-12);
 }
 
 TEST(RunView, NodesAreServedAsFloatsAndAddUpToTheMap) {

@@ -26,6 +26,7 @@ using ::testing::HasSubstr;
 /// Ports of this test process (the live tests use 30000 and up).
 int port(int k) { return 20000 + (getpid() % 5000) * 2 + k; }
 
+/// The lines of a text file that are not empty or comments.
 std::size_t tumRows(const std::filesystem::path& path) {
   std::ifstream in(path);
   std::size_t rows = 0;
@@ -76,6 +77,10 @@ TEST(ViewCli, TheViewerShowsAFinishedRunInHeadlessChromium) {
                                        (sim / "rig.yaml").string(), run.string()))
                 .exit_code,
             0);
+  // The tree layer: `taiga trees` writes RUN/trees.csv, the viewer draws its stems.
+  ASSERT_EQ(test::runTaiga("trees " + run.string()).exit_code, 0);
+  const std::size_t stems = tumRows(run / "trees.csv") - 1;  // its rows less the header
+  ASSERT_GT(stems, 3u);
   const std::string address = fmt::format("127.0.0.1:{}", port(0));
   auto view = std::async(std::launch::async, [&] {
     return test::runTaiga(fmt::format("view {} --bind {}", run.string(), address));
@@ -96,6 +101,7 @@ TEST(ViewCli, TheViewerShowsAFinishedRunInHeadlessChromium) {
   EXPECT_EQ(report["state"]["keyframes"].get<std::size_t>(), tumRows(run / "keyframes.tum"));
   EXPECT_EQ(report["state"]["scans"].get<std::size_t>(), tumRows(run / "trajectory.tum"));
   EXPECT_GT(report["state"]["nodesShown"].get<int>(), 1);  // detail was fetched where it is near
+  EXPECT_EQ(report["state"]["trees"].get<std::size_t>(), stems);
 }
 
 TEST(ViewCli, TheViewerFollowsALiveRun) {

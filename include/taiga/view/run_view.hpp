@@ -6,7 +6,7 @@
 // HTTP API (JSON unless said; coordinates in the map frame relative to `origin`, in metres):
 //   /api/info     mode ("run" or "live"), name, origin, point count, the trajectory (t, x, y, z),
 //                 keyframe positions, accepted loop closures (two positions each), per-scan time
-//                 and status, and summary.json's health and time per scan
+//                 and status, the trees of trees.csv, and summary.json's health and time per scan
 //   /api/nodes    the level-of-detail octree (lod_tree.hpp): per node its cube, depth, parent,
 //                 children and point count
 //   /api/node/N   node N's points: float32 little-endian x, y, z, intensity per point
