@@ -42,6 +42,9 @@ MotionUpdate ConstantVelocityPrior::update(const std::optional<backend::PoseMeas
   MotionUpdate update;
   update.state.T_odom_body = T_odom_body;
   update.state.v_odom = T_odom_body.rotation() * last_->twist_per_s.head<3>();
+  // From the SE(3) tangent [rho; theta] at the pose to [dp (odom); dtheta]: dp = R rho to
+  // first order.
+  if (lidar) update.state.covariance = rotatedCovariance(lidar->covariance, T_odom_body.rotation());
   return update;
 }
 

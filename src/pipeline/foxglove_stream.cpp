@@ -117,10 +117,13 @@ std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_po
       "taiga", 64u << 20, std::move(http));
 }
 
-std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body) {
-  return nlohmann::json{
-      {"timestamp", timestamp(t_s)}, {"frame_id", "map"}, {"pose", pose(T_map_body)}}
-      .dump();
+std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body,
+                            const std::optional<lie::Matrix6>& covariance) {
+  nlohmann::json message = {
+      {"timestamp", timestamp(t_s)}, {"frame_id", "map"}, {"pose", pose(T_map_body)}};
+  if (covariance)
+    message["covariance"] = std::vector<double>(covariance->data(), covariance->data() + 36);
+  return message.dump();
 }
 
 FoxgloveMapStream::FoxgloveMapStream(stream::FoxgloveServer& server, const Odometry& odometry,

@@ -1,7 +1,8 @@
 #pragma once
 // live.foxglove: a run watched over the Foxglove WebSocket protocol (stream/foxglove_server.hpp;
 // docs/live.md, "Foxglove"). Channels, every message JSON in the map frame:
-//   /taiga/pose            foxglove.PoseInFrame   each scan's pose as published (PoseStream)
+//   /taiga/pose            foxglove.PoseInFrame   each scan's pose as published, with its
+//                                                 covariance (PoseStream)
 //   /taiga/imu_pose        foxglove.PoseInFrame   the IMU-rate dead-reckoned pose (PoseStream)
 //   /taiga/scan            foxglove.PointCloud    each scan as registered (deskewed,
 //                                                 voxel-filtered) at its pose as published
@@ -51,8 +52,10 @@ enum FoxgloveTopic : std::size_t {
 std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_port,
                                                       stream::HttpHandler http = {});
 
-/// A foxglove.PoseInFrame message in the map frame.
-std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body);
+/// A foxglove.PoseInFrame message in the map frame; with `covariance` (of [dp (map frame, m);
+/// dtheta (body frame, rad)], row-major) as an extra field, which Foxglove ignores.
+std::string poseInFrameJson(double t_s, const lie::SE3& T_map_body,
+                            const std::optional<lie::Matrix6>& covariance = std::nullopt);
 
 /// Scans, keyframes, scan health, the graph's corrections and the online georeference to the
 /// server's channels. `odometry` is the system's (its local map); `gnss` (optional) the run's

@@ -133,7 +133,8 @@ MotionUpdate ImuPrior::update(const std::optional<backend::PoseMeasurement>& lid
       smoother_.addState(predicted_t_s_, *preintegrated_, lidar);
   imu_.dropBefore(estimate.t_s);
   MotionUpdate update;
-  update.state = {poseOf(estimate.state), estimate.state.v_world, estimate.bias};
+  update.state = {poseOf(estimate.state), estimate.state.v_world, estimate.bias,
+                  estimate.covariance.topLeftCorner<6, 6>()};
   if (!levelled_) {
     // The lidar's own pose where registration worked: the alignment must not see the IMU's
     // (wrongly levelled) prediction; the fused pose otherwise.
@@ -144,6 +145,7 @@ MotionUpdate ImuPrior::update(const std::optional<backend::PoseMeasurement>& lid
       const backend::StateEstimate levelled = smoother_.latest();
       update.state.T_odom_body = poseOf(levelled.state);
       update.state.v_odom = levelled.state.v_world;
+      update.state.covariance = levelled.covariance.topLeftCorner<6, 6>();
     }
   }
   preintegrated_.reset();

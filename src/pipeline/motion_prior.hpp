@@ -62,7 +62,18 @@ struct MotionState {
   lie::SE3 T_odom_body;
   Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();
   imu::ImuBias bias;
+  /// The pose's covariance, [dp (odom frame, m); dtheta (body frame, rad)]: with an IMU the
+  /// smoother's marginal; lidar-only the registration's; none when nothing measured the pose.
+  /// Local: relative to the odom frame and its map, it does not grow with drift.
+  std::optional<lie::Matrix6> covariance;
 };
+
+/// A pose covariance [dp; dtheta (body)] with dp's frame turned by R_new_old.
+inline lie::Matrix6 rotatedCovariance(const lie::Matrix6& covariance, const lie::SO3& R_new_old) {
+  lie::Matrix6 J = lie::Matrix6::Identity();
+  J.topLeftCorner<3, 3>() = R_new_old.matrix();
+  return J * covariance * J.transpose();
+}
 
 struct MotionUpdate {
   MotionState state;

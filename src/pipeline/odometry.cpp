@@ -177,6 +177,7 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   outcome.T_odom_body = update.state.T_odom_body;
   outcome.v_odom = update.state.v_odom;
   outcome.bias = update.state.bias;
+  outcome.covariance = update.state.covariance;
   if (update.T_odom_unlevelled) {
     // The keyframes so far were deskewed with the velocity still unknown (zero at the start): the
     // local map starts over from this scan, deskewed with the velocity the odometry has found.

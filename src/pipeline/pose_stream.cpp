@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include "foxglove_stream.hpp"
+#include "motion_prior.hpp"
+#include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/live_config.hpp"
 
@@ -36,13 +38,14 @@ PoseStream::PoseStream(const std::string& udp_address, stream::FoxgloveServer* f
   if (!udp_address.empty()) socket_ = openSocket(udp_address);
 }
 
-void PoseStream::send(const char* type, double t_s, const imu::NavState& s, const char* status) {
+void PoseStream::send(const char* type, double t_s, const imu::NavState& s, const char* status,
+                      const std::optional<lie::Matrix6>& covariance) {
   ++sent_;
   if (foxglove_ != nullptr) {
     const std::size_t topic = status != nullptr ? kPoseTopic : kImuPoseTopic;
     if (foxglove_->subscribed(topic))
       foxglove_->publish(topic, static_cast<std::uint64_t>(std::llround(t_s * 1e9)),
-                         poseInFrameJson(t_s, lie::SE3(s.R_world_body, s.p_world)));
+                         poseInFrameJson(t_s, lie::SE3(s.R_world_body, s.p_world), covariance));
   }
   if (!socket_) return;
   const Eigen::Quaterniond q = s.R_world_body.quaternion();
@@ -51,6 +54,14 @@ void PoseStream::send(const char* type, double t_s, const imu::NavState& s, cons
       type, t_s, s.p_world.x(), s.p_world.y(), s.p_world.z(), q.x(), q.y(), q.z(), q.w(),
       s.v_world.x(), s.v_world.y(), s.v_world.z());
   if (status != nullptr) text += fmt::format(R"(,"status":"{}")", status);
+  if (covariance) {
+    const lie::Vector6 sigma = covariance->diagonal().cwiseSqrt();
+    text += fmt::format(R"(,"sigma_m":[{:.4f},{:.4f},{:.4f}],"sigma_deg":[{:.4f},{:.4f},{:.4f}])",
+                        sigma[0], sigma[1], sigma[2], sigma[3] * kDegPerRad,
+                        sigma[4] * kDegPerRad, sigma[5] * kDegPerRad);
+    text += fmt::format(R"(,"cov":[{:.4e}])",
+                        fmt::join(covariance->data(), covariance->data() + 36, ","));
+  }
   if (status == nullptr) text += fmt::format(R"(,"age_s":{:.3f})", t_s - anchor_->t_s);
   text += "}\n";
   socket_->send(std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
@@ -65,7 +76,9 @@ void PoseStream::onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) {
       .state = {T_map_body.rotation(), T_map_body.translation(), R_map_odom * scan.v_odom},
       .bias = scan.bias,
       .gravity_map = R_map_odom * Eigen::Vector3d(0.0, 0.0, -gravity_mps2_)};
-  send("scan", scan.t_s, anchor.state, scanStatusName(scan.health.status));
+  send("scan", scan.t_s, anchor.state, scanStatusName(scan.health.status),
+       scan.covariance ? std::optional(rotatedCovariance(*scan.covariance, T_map_odom.rotation()))
+                       : std::nullopt);
   anchor_ = anchor;
   current_ = {anchor.t_s, anchor.state};
   // The samples that arrived after the scan's end are carried forward from the new anchor

@@ -43,7 +43,9 @@ class PoseStream final : public SlamObserver {
 
  private:
   /// One pose to every output; `status` is the scan's, null for an IMU-rate pose.
-  void send(const char* type, double t_s, const imu::NavState& state, const char* status);
+  /// `covariance`: the scan pose's, [dp (map frame); dtheta (body)] (scans only).
+  void send(const char* type, double t_s, const imu::NavState& state, const char* status,
+            const std::optional<lie::Matrix6>& covariance = std::nullopt);
   /// Carries the dead-reckoned state forward to `sample` and sends it; with the lock held.
   void advance(const ImuSample& sample_body);
   /// Dead-reckons the current state to `sample` with the anchor's bias and gravity.

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "motion_prior.hpp"
 #include "odometry_correction.hpp"
 
 namespace taiga::pipeline {
@@ -30,6 +31,8 @@ mapping::MappingThreadOptions mappingThreadOptions(
 void reexpress(ScanOutcome& outcome, const lie::SE3& T_odom_unlevelled) {
   outcome.T_odom_body = T_odom_unlevelled * outcome.T_odom_body;
   for (StampedPose& p : outcome.imu_rate_poses) p.pose = T_odom_unlevelled * p.pose;
+  if (outcome.covariance) outcome.covariance = rotatedCovariance(*outcome.covariance,
+                                                                 T_odom_unlevelled.rotation());
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <future>
 #include <iterator>
@@ -155,7 +156,7 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
   const std::vector<nlohmann::json> poses = pose_receiver.stop();
   const auto online = tumPositions(live_run / "trajectory_online.tum");
   const auto imu_rate = tumPositions(live_run / "trajectory_imu.tum");
-  std::size_t scans = 0, imu = 0, imu_fresh = 0, imu_fresh_near = 0;
+  std::size_t scans = 0, imu = 0, imu_fresh = 0, imu_fresh_near = 0, with_covariance = 0;
   for (const nlohmann::json& pose : poses) {
     const Eigen::Vector3d p(pose["p"][0], pose["p"][1], pose["p"][2]);
     const long long key = std::llround(pose["t_s"].get<double>() * 1e4);
@@ -164,6 +165,19 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
       ASSERT_TRUE(online.contains(key)) << pose.dump();
       EXPECT_LT((online.at(key) - p).norm(), 1e-3) << pose.dump();
       EXPECT_EQ(pose["status"], "ok");
+      // The pose's covariance: millimetres to decimetres, tenths of degrees, symmetric.
+      if (!pose.contains("cov")) continue;  // nothing measured the first scan's pose
+      ++with_covariance;
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_GT(pose["sigma_m"][i].get<double>(), 1e-4) << pose.dump();
+        EXPECT_LT(pose["sigma_m"][i].get<double>(), 0.3) << pose.dump();
+        EXPECT_GT(pose["sigma_deg"][i].get<double>(), 1e-3) << pose.dump();
+        EXPECT_LT(pose["sigma_deg"][i].get<double>(), 5.0) << pose.dump();
+      }
+      ASSERT_EQ(pose["cov"].size(), 36u);
+      EXPECT_NEAR(std::sqrt(pose["cov"][0].get<double>()), pose["sigma_m"][0].get<double>(),
+                  1e-4);  // printed to 0.1 mm
+      EXPECT_NEAR(pose["cov"][1].get<double>(), pose["cov"][6].get<double>(), 1e-9);
     } else {
       ++imu;
       const auto it = imu_rate.find(key);
@@ -176,6 +190,7 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
     }
   }
   EXPECT_EQ(scans, online.size());
+  EXPECT_GE(with_covariance + 1, scans);
   // At most 200 Hz over the 1.4 s after the odom frame is levelled; fewer on a loaded machine,
   // where the odometry lags by more than the 1 s that IMU-rate poses are dead-reckoned.
   EXPECT_GT(imu, 20u);

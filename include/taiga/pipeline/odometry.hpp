@@ -75,6 +75,8 @@ struct ScanOutcome {
   lie::SE3 T_odom_body;
   Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();
   imu::ImuBias bias;
+  /// T_odom_body's covariance [dp (odom frame, m); dtheta (body frame, rad)] (MotionState).
+  std::optional<lie::Matrix6> covariance;
   LidarFactor lidar = LidarFactor::kFirstScan;
   std::string lidar_note;  ///< why a factor was rejected or inflated
   registration::RegistrationResult registration;
