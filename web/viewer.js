@@ -4,7 +4,8 @@
 //   only the nodes in view that are large on screen, within a point budget;
 // - a live run (`taiga run --view`): the Foxglove WebSocket channels on the same port
 //   (/taiga/pose, /taiga/scan, /taiga/keyframes, /taiga/health, /taiga/keyframe_poses,
-//   /taiga/loops, /taiga/georef; docs/live.md): keyframes move where the mapping graph puts them.
+//   /taiga/loops, /taiga/georef, /taiga/trees; docs/live.md): keyframes move where the mapping
+//   graph puts them.
 // The map frame is z-up, in metres; everything is drawn relative to the server's origin.
 // window.taigaView holds counters for tests (tools/viewer-check).
 import * as THREE from "three";
@@ -142,6 +143,11 @@ const trees = new THREE.Group();
 scene.add(trees);
 document.getElementById("show-trees").addEventListener("change", (e) => { trees.visible = e.target.checked; requestRender(); });
 function showTrees(rows) {
+  for (const old of [...trees.children]) {
+    trees.remove(old);
+    old.geometry.dispose();
+  }
+  state.trees = 0;
   if (rows.length === 0) return;
   const stem = new THREE.CylinderGeometry(0.5, 0.5, 1, 12);
   stem.rotateX(Math.PI / 2);  // along z
@@ -355,7 +361,7 @@ async function showRun(info) {
 const live = { subscriptions: new Map(), keyframes: new Map(), keyframePoints: 0, graph: [],
                loops: [], scanObject: null, ms: [], status: [], zRange: null, t0: null };
 const liveTopics = ["/taiga/pose", "/taiga/scan", "/taiga/keyframes", "/taiga/health",
-                    "/taiga/keyframe_poses", "/taiga/loops", "/taiga/georef"];
+                    "/taiga/keyframe_poses", "/taiga/loops", "/taiga/georef", "/taiga/trees"];
 const decoder = new TextDecoder();
 
 function decodeCloud(message) {
@@ -436,6 +442,8 @@ function onLiveMessage(topic, message) {
     live.loops.push([message.keyframe, message.candidate]);
     state.loops = live.loops.length;
     drawGraph();
+  } else if (topic === "/taiga/trees") {
+    showTrees(message.trees);
   } else if (topic === "/taiga/georef") {
     ++state.georef;
     const [e, n] = message.sigma;

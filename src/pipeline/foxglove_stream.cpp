@@ -64,6 +64,8 @@ const char* kGridPoseSchema =
     R"({"type":"object","properties":{"t_s":{"type":"number"},"epsg":{"type":"integer"},"easting_m":{"type":"number"},"northing_m":{"type":"number"},"height_m":{"type":"number"},"yaw_grid_deg":{"type":"number"},"sigma":{"type":"array"},"fixes":{"type":"integer"}}})";
 const char* kLocationFixSchema =
     R"({"type":"object","properties":{"timestamp":{"type":"object"},"frame_id":{"type":"string"},"latitude":{"type":"number"},"longitude":{"type":"number"},"altitude":{"type":"number"},"position_covariance":{"type":"array"},"position_covariance_type":{"type":"integer"}}})";
+const char* kTreeListSchema =
+    R"({"type":"object","properties":{"trees":{"type":"array","items":{"type":"array","description":"x, y, ground z, DBH, height; m"}}}})";
 const char* kHealthSchema =
     R"({"type":"object","properties":{"t_s":{"type":"number"},"status":{"type":"string"},"reason":{"type":"string"},"processing_ms":{"type":"number"},"points":{"type":"integer"}}})";
 
@@ -113,7 +115,8 @@ std::unique_ptr<stream::FoxgloveServer> startFoxglove(const std::string& host_po
           {"/taiga/keyframe_poses", "foxglove.PosesInFrame", kPosesInFrameSchema},
           {"/taiga/loops", "taiga.LoopClosure", kLoopSchema},
           {"/taiga/georef", "taiga.GridPose", kGridPoseSchema},
-          {"/taiga/fix", "foxglove.LocationFix", kLocationFixSchema}},
+          {"/taiga/fix", "foxglove.LocationFix", kLocationFixSchema},
+          {"/taiga/trees", "taiga.TreeList", kTreeListSchema}},
       "taiga", 64u << 20, std::move(http));
 }
 
@@ -197,6 +200,17 @@ void FoxgloveMapStream::onGraph(const mapping::Mapper& mapper) {
                                  .dump()};
     server_.publish(kLoopsTopic, nanoseconds(record.t_s), loop.json, &loop);
   }
+}
+
+void FoxgloveMapStream::publishTrees(const std::vector<trees::Stem>& stems) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const trees::Stem& stem : stems) {
+    const Eigen::Vector2d at = stem.axisAt(1.3);
+    rows.push_back({at.x(), at.y(), stem.ground_z_m, stem.dbh_m, stem.height_m});
+  }
+  const stream::FoxgloveServer::Kept latest{nlohmann::json{{"trees", rows}}.dump(),
+                                            /*replace=*/true};
+  server_.publish(kTreesTopic, 0, latest.json, &latest);
 }
 
 void FoxgloveMapStream::publishGeoreference(double t_s) {

@@ -19,8 +19,10 @@
 //   /taiga/georef          taiga.GridPose         each scan's pose in the grid (EPSG) with 1-sigma,
 //                                                 once the online georeference has an estimate
 //   /taiga/fix             foxglove.LocationFix   the same as latitude and longitude (a map panel)
+//   /taiga/trees           taiga.TreeList         the online tree map (mapping.trees) as it is
+//                                                 rewritten: [x, y, ground z, DBH, height] per stem
 // A client that subscribes late gets the keyframes so far (thinned further), the latest keyframe
-// poses and every loop closure first.
+// poses and tree list, and every loop closure first.
 // Internal to the pipeline.
 
 #include <memory>
@@ -31,6 +33,7 @@
 #include "taiga/lie/se3.hpp"
 #include "taiga/pipeline/slam_system.hpp"
 #include "taiga/stream/foxglove_server.hpp"
+#include "taiga/trees/stem_detection.hpp"
 
 namespace taiga::pipeline {
 
@@ -44,7 +47,8 @@ enum FoxgloveTopic : std::size_t {
   kKeyframePosesTopic,
   kLoopsTopic,
   kGeorefTopic,
-  kFixTopic
+  kFixTopic,
+  kTreesTopic
 };
 
 /// The server with the channels above, on "host:port", answering plain HTTP with `http` (the
@@ -68,6 +72,8 @@ class FoxgloveMapStream final : public SlamObserver {
   void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
   void onKeyframe(std::uint64_t id, const ScanOutcome& scan) override;
   void onGraph(const mapping::Mapper& mapper) override;  // on the mapping thread
+  /// The online tree map's list (OnlineTrees' on_list; any thread), kept for late clients.
+  void publishTrees(const std::vector<trees::Stem>& stems);
 
  private:
   void publishGeoreference(double t_s);

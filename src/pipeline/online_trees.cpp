@@ -27,8 +27,12 @@ bool overlap(const trees::Stem& a, const trees::Stem& b) {
 
 }  // namespace
 
-OnlineTrees::OnlineTrees(const mapping::KeyframeStore& store, std::filesystem::path trees_csv)
-    : store_(store), trees_csv_(std::move(trees_csv)), worker_([this] { run(); }) {}
+OnlineTrees::OnlineTrees(const mapping::KeyframeStore& store, std::filesystem::path trees_csv,
+                         std::function<void(const std::vector<trees::Stem>&)> on_list)
+    : store_(store),
+      trees_csv_(std::move(trees_csv)),
+      on_list_(std::move(on_list)),
+      worker_([this] { run(); }) {}
 
 OnlineTrees::~OnlineTrees() {
   {
@@ -125,6 +129,7 @@ void OnlineTrees::writeCsv(const std::vector<trees::Stem>& stems) const {
   const std::filesystem::path partial = trees_csv_.string() + ".partial";
   trees::writeTreesCsv(partial, sorted, Eigen::Vector3d::Zero(), std::nullopt);
   std::filesystem::rename(partial, trees_csv_);
+  if (on_list_) on_list_(sorted);
 }
 
 std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -29,7 +30,10 @@ namespace taiga::pipeline {
 
 class OnlineTrees final : public SlamObserver {
  public:
-  OnlineTrees(const mapping::KeyframeStore& store, std::filesystem::path trees_csv);
+  /// `on_list` (optional) gets each list as it is written (on the worker thread, and the final
+  /// one on the caller's), e.g. for the live stream.
+  OnlineTrees(const mapping::KeyframeStore& store, std::filesystem::path trees_csv,
+              std::function<void(const std::vector<trees::Stem>&)> on_list = {});
   ~OnlineTrees() override;
   OnlineTrees(const OnlineTrees&) = delete;
   OnlineTrees& operator=(const OnlineTrees&) = delete;
@@ -54,6 +58,7 @@ class OnlineTrees final : public SlamObserver {
 
   const mapping::KeyframeStore& store_;
   std::filesystem::path trees_csv_;
+  std::function<void(const std::vector<trees::Stem>&)> on_list_;
   lie::SE3 T_map_odom_;
   std::vector<Keyframe> keyframes_;  ///< every keyframe, live poses (worker reads under mutex_)
   std::vector<Keyframe> pending_;    ///< not yet in an update

@@ -269,7 +269,12 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   }
   std::optional<OnlineTrees> online_trees;
   if (config.mapping.trees)
-    slam.addObserver(online_trees.emplace(slam.keyframes(), out / "trees.csv"));
+    slam.addObserver(online_trees.emplace(
+        slam.keyframes(), out / "trees.csv",
+        foxglove_map ? std::function([&](const std::vector<trees::Stem>& stems) {
+          foxglove_map->publishTrees(stems);
+        })
+                     : nullptr));
 
   RunSummary summary;
   const auto wall_start = Clock::now();

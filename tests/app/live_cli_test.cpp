@@ -257,9 +257,9 @@ TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
 
 // A client that connects while a run goes gets the map so far (every keyframe once, in order),
 // the mapping graph's keyframe poses after each keyframe, its loop closures, and from then on the
-// online georeference: here a recording with GNSS fixes, run from the file at full speed, whose
-// walk closes its loop.
-TEST(LiveCli, AFoxgloveClientThatJoinsLateGetsTheMapTheGraphLoopsAndGeoreference) {
+// online georeference and the online tree map: here a recording with GNSS fixes, run from the
+// file at full speed with mapping.trees, whose walk closes its loop.
+TEST(LiveCli, AFoxgloveClientThatJoinsLateGetsTheMapGraphLoopsGeoreferenceAndTrees) {
   test::TempDir dir;
   const auto sim = dir.file("sim");
   ASSERT_EQ(test::runTaiga("simulate --scenario handheld-loop --duration 30 --beams 32 --columns "
@@ -270,6 +270,7 @@ TEST(LiveCli, AFoxgloveClientThatJoinsLateGetsTheMapTheGraphLoopsAndGeoreference
   const int ws_port = 7505 + portOffset();
   YAML::Node config = YAML::LoadFile((sim / "rig.yaml").string());
   config["live"]["foxglove"] = fmt::format("127.0.0.1:{}", ws_port);
+  config["mapping"]["trees"] = true;
   const auto config_path = dir.write("foxglove.yaml", YAML::Dump(config) + "\n");
   auto client = std::async(std::launch::async, [&] {
     return test::runCommand(fmt::format(
@@ -324,6 +325,15 @@ TEST(LiveCli, AFoxgloveClientThatJoinsLateGetsTheMapTheGraphLoopsAndGeoreference
     EXPECT_EQ(loops[i]["keyframe"], accepted[i].first);
     EXPECT_EQ(loops[i]["candidate"], accepted[i].second);
   }
+
+  // The online tree map: the last list sent is the final trees.csv.
+  const nlohmann::json& tree_lists = topics["/taiga/trees"]["messages"];
+  ASSERT_FALSE(tree_lists.empty());
+  std::ifstream trees_csv(out / "trees.csv");
+  std::size_t stems = 0;
+  for (std::getline(trees_csv, line); std::getline(trees_csv, line);) ++stems;
+  EXPECT_GT(stems, 5u);
+  EXPECT_EQ(tree_lists.back()["trees"].size(), stems);
 
   // The online georeference in the grid and as latitude and longitude (the simulator's forest
   // is in Finland), the last one as georef/trajectory_online_epsg3067.csv has it.
