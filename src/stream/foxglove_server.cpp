@@ -208,7 +208,7 @@ FoxgloveServer::FoxgloveServer(const std::string& address, std::uint16_t port,
   s.server.listen(asio::ip::tcp::endpoint(asio::ip::make_address(address, error), port), error);
   if (!error) s.server.start_accept(error);
   if (error)
-    throw InputError(fmt::format("{}:{}: cannot serve the Foxglove WebSocket there: {}", address,
+    throw InputError(fmt::format("{}:{}: cannot listen there (WebSocket and HTTP): {}", address,
                                  port, error.message()));
   s.thread = std::thread([&s] { s.server.run(); });
   if (!s.channels.empty())

@@ -22,6 +22,7 @@
 #include <thread>
 
 #include "../support/run_taiga.hpp"
+#include "../support/simulated_capture.hpp"
 #include "../support/temp_dir.hpp"
 #include "taiga/io/udp_socket.hpp"
 
@@ -53,16 +54,6 @@ std::filesystem::path liveConfig(const std::filesystem::path& sim, double idle_t
   return path;
 }
 
-/// A 4 s walk with its capture in the low-data-rate profile (32 beams x 512 columns).
-std::filesystem::path simulate(const test::TempDir& dir) {
-  const auto sim = dir.file("sim");
-  const test::TaigaResult r = test::runTaiga(
-      "simulate --scenario mixed --duration 4 --beams 32 --columns 512 --seed 4 --pcap "
-      "RNG15_RFL8_NIR8 --out " +
-      sim.string());
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  return sim;
-}
 
 /// The pose stream's datagrams (live.pose_udp), parsed, collected on a thread until stop().
 class PoseReceiver {
@@ -119,7 +110,7 @@ std::future<test::TaigaResult> startLive(const std::filesystem::path& config,
 
 TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
   test::TempDir dir;
-  const auto sim = simulate(dir);
+  const auto sim = test::simulateCapture(dir);
   // The file run on one worker thread, the live run on every core: the thread count changes no
   // output (the parallel sums add fixed blocks in a fixed order).
   const auto file_run = sim / "file_run";
@@ -201,7 +192,7 @@ TEST(LiveCli, AReplayedCaptureRunLiveGivesTheTrajectoryOfTheCaptureFile) {
 // to a live run and receives the poses, the IMU-rate poses, the keyframes and the scan health.
 TEST(LiveCli, AFoxgloveClientReceivesPosesKeyframesAndHealth) {
   test::TempDir dir;
-  const auto sim = simulate(dir);
+  const auto sim = test::simulateCapture(dir);
   const int ws_port = 7505 + portOffset();
   YAML::Node config = YAML::LoadFile(liveConfig(sim, 3.0).string());
   config["live"]["foxglove"] = fmt::format("127.0.0.1:{}", ws_port);
@@ -364,7 +355,7 @@ TEST(LiveCli, AFoxgloveClientThatJoinsLateGetsTheMapGraphLoopsGeoreferenceAndTre
 // another sensor: the run ends with exit 2 and says which.
 TEST(LiveCli, MetadataOfAnotherProfileOrSensorIsNamed) {
   test::TempDir dir;
-  const auto sim = simulate(dir);
+  const auto sim = test::simulateCapture(dir);
   const nlohmann::json metadata = nlohmann::json::parse(readText(sim / "capture.json"));
   nlohmann::json other_profile = metadata, other_sensor = metadata;
   other_profile["lidar_data_format"]["udp_profile_lidar"] = "LEGACY";
@@ -389,7 +380,7 @@ TEST(LiveCli, MetadataOfAnotherProfileOrSensorIsNamed) {
 
 TEST(LiveCli, SigtermEndsALiveRunWithItsOutputsWritten) {
   test::TempDir dir;
-  const auto sim = simulate(dir);
+  const auto sim = test::simulateCapture(dir);
   const auto config = liveConfig(sim, 0.0);  // waits for packets until stopped
   const auto out = sim / "stopped_run";
   auto live = startLive(config, out);

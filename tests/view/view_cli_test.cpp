@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "../support/run_taiga.hpp"
+#include "../support/simulated_capture.hpp"
 #include "../support/temp_dir.hpp"
 
 namespace taiga::app {
@@ -35,16 +36,6 @@ std::size_t tumRows(const std::filesystem::path& path) {
   return rows;
 }
 
-/// A 4 s walk (32 beams x 512 columns) with its capture.
-std::filesystem::path simulate(const test::TempDir& dir) {
-  const auto sim = dir.file("sim");
-  const test::TaigaResult r = test::runTaiga(
-      "simulate --scenario mixed --duration 4 --beams 32 --columns 512 --seed 4 --pcap "
-      "RNG15_RFL8_NIR8 --out " +
-      sim.string());
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  return sim;
-}
 
 /// tools/viewer-check's report on the page at `url`, its screenshot written to `png`.
 nlohmann::json checkPage(const std::string& url, const std::filesystem::path& png) {
@@ -70,7 +61,7 @@ void expectAPageThatDrewTheMap(const nlohmann::json& report, const std::filesyst
 
 TEST(ViewCli, TheViewerShowsAFinishedRunInHeadlessChromium) {
   test::TempDir dir;
-  const auto sim = simulate(dir);
+  const auto sim = test::simulateCapture(dir);
   const auto run = sim / "run";
   ASSERT_EQ(test::runTaiga(fmt::format("run {} --config {} --out {}",
                                        (sim / "recording.bag").string(),
@@ -106,7 +97,7 @@ TEST(ViewCli, TheViewerShowsAFinishedRunInHeadlessChromium) {
 
 TEST(ViewCli, TheViewerFollowsALiveRun) {
   test::TempDir dir;
-  const auto sim = simulate(dir);
+  const auto sim = test::simulateCapture(dir);
   const int offset = port(0) + 10000 - 7502;  // lidar and IMU ports: 30000 + (pid % 5000) * 2
   YAML::Node config = YAML::LoadFile((sim / "rig.yaml").string());
   config["live"]["bind_address"] = "127.0.0.1";

@@ -2,11 +2,14 @@
 // and prints one JSON object: the page's console errors and uncaught exceptions, its counters
 // (window.taigaView: mode, points shown, poses, keyframes, scans), and how many pixels of the 3D
 // view differ from the background; writes a screenshot. Retries loading until the server is up.
-// Usage: node viewer-check.mjs URL SCREENSHOT.png [TIMEOUT_S]
+// With --orbit, it then drags the view around for 5 s as a user would and reports the frames
+// drawn per second, the points shown and the node bytes fetched (bench/viewer.sh).
+// Usage: node viewer-check.mjs URL SCREENSHOT.png [TIMEOUT_S] [--orbit]
 import { chromium } from "playwright-core";
 
 const [url, screenshot] = process.argv.slice(2, 4);
 const timeoutS = Number(process.argv[4] ?? 60);
+const orbit = process.argv.includes("--orbit");
 const deadline = Date.now() + timeoutS * 1000;
 
 const browser = await chromium.launch({
@@ -48,9 +51,31 @@ try {
     return { lit, of: data.length / 4 };
   });
   await page.screenshot({ path: screenshot });
+  if (orbit) result.orbit = await dragAround(page);
 } catch (e) {
   result.error = String(e);
 } finally {
   await browser.close();
 }
 process.stdout.write(JSON.stringify(result) + "\n");
+
+/// Drags the view in a circle for 5 s (OrbitControls turns it), then lets the detail load.
+async function dragAround(page) {
+  const before = await page.evaluate(() => window.taigaView.frames);
+  const start = Date.now();
+  await page.mouse.move(640, 400);
+  await page.mouse.down();
+  let maxShown = 0;
+  for (let i = 0; Date.now() - start < 5000; ++i) {
+    await page.mouse.move(640 + 200 * Math.cos(i / 20), 400 + 60 * Math.sin(i / 20), { steps: 2 });
+    maxShown = Math.max(maxShown, await page.evaluate(() => window.taigaView.pointsShown));
+  }
+  await page.mouse.up();
+  const seconds = (Date.now() - start) / 1000;
+  const frames = (await page.evaluate(() => window.taigaView.frames)) - before;
+  await page.waitForFunction(() => window.taigaView.loading === 0, null, { timeout: 60000 });
+  const fetched = await page.evaluate(() => performance.getEntriesByType("resource")
+    .filter((e) => e.name.includes("/api/node/"))
+    .reduce((sum, e) => ({ nodes: sum.nodes + 1, bytes: sum.bytes + e.encodedBodySize }), { nodes: 0, bytes: 0 }));
+  return { seconds, frames, fps: frames / seconds, maxPointsShown: maxShown, fetched };
+}
