@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
     writer.append(copy);
   }
   writer.close();
-  fmt::print("{} copies of {} points: {} points in {}\n", copies, tile.size(),
-             writer.pointCount(), argv[3]);
+  fmt::print("{} copies of {} points: {} points in {}\n", copies, tile.size(), writer.pointCount(),
+             argv[3]);
   return 0;
 }

@@ -31,10 +31,9 @@ int runView(const ViewOptions& options) {
   const view::RunView run_view = view::RunView::load(options.input);
   const double load_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stream::FoxgloveServer server(address->first, address->second, {}, "taiga view", 64u << 20,
-                                [&run_view](const std::string& resource) {
-                                  return run_view.get(resource);
-                                });
+  stream::FoxgloveServer server(
+      address->first, address->second, {}, "taiga view", 64u << 20,
+      [&run_view](const std::string& resource) { return run_view.get(resource); });
   fmt::print("view       {} points in {} level-of-detail nodes, read and indexed in {:.1f} s\n",
              run_view.tree().pointCount(), run_view.tree().nodes().size(), load_s);
   fmt::print("serving    http://{}:{}/ (Ctrl-C ends)\n", address->first, server.port());

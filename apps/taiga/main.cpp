@@ -35,8 +35,7 @@ int runTool(int argc, char** argv) {
       addRegisterCommand(tool),  addRunCommand(tool),       addEvalCommand(tool),
       addCompareCommand(tool),   addGeorefCommand(tool),    addConfigCommand(tool),
       addExportMapCommand(tool), addCalibrateCommand(tool), addTreesCommand(tool),
-      addViewCommand(tool),
-      addReplayCommand(tool)};
+      addViewCommand(tool),      addReplayCommand(tool)};
 
   try {
     tool.parse(argc, argv);

@@ -192,12 +192,13 @@ void FoxgloveMapStream::onGraph(const mapping::Mapper& mapper) {
   for (; loop_attempts_seen_ < attempts.size(); ++loop_attempts_seen_) {
     const mapping::LoopRecord& record = attempts[loop_attempts_seen_];
     if (!record.attempt.accepted) continue;
-    const stream::FoxgloveServer::Kept loop{nlohmann::json{{"t_s", record.t_s},
-                                            {"keyframe", record.attempt.current},
-                                            {"candidate", record.attempt.candidate.keyframe},
-                                            {"correction_m", record.attempt.correction_m},
-                                            {"correction_deg", record.attempt.correction_deg}}
-                                 .dump()};
+    const stream::FoxgloveServer::Kept loop{nlohmann::json{
+        {"t_s", record.t_s},
+        {"keyframe", record.attempt.current},
+        {"candidate", record.attempt.candidate.keyframe},
+        {"correction_m", record.attempt.correction_m},
+        {"correction_deg",
+         record.attempt.correction_deg}}.dump()};
     server_.publish(kLoopsTopic, nanoseconds(record.t_s), loop.json, &loop);
   }
 }
@@ -233,8 +234,8 @@ void FoxgloveMapStream::publishGeoreference(double t_s) {
   if (!grid_) grid_ = std::make_unique<geo::CoordinateConverter>(gnss_->epsg());
   const geo::Geodetic g = grid_->fromProjected({p.easting_m, p.northing_m, p.height_m});
   // East, north, up variances on the diagonal (ENU, row-major), as LocationFix has them.
-  const std::vector<double> covariance = {sigma[0] * sigma[0], 0, 0, 0, sigma[1] * sigma[1], 0,
-                                          0, 0, sigma[2] * sigma[2]};
+  const std::vector<double> covariance = {
+      sigma[0] * sigma[0], 0, 0, 0, sigma[1] * sigma[1], 0, 0, 0, sigma[2] * sigma[2]};
   server_.publish(kFixTopic, nanoseconds(t_s),
                   nlohmann::json{{"timestamp", timestamp(t_s)},
                                  {"frame_id", "map"},

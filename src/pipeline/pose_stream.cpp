@@ -57,8 +57,8 @@ void PoseStream::send(const char* type, double t_s, const imu::NavState& s, cons
   if (covariance) {
     const lie::Vector6 sigma = covariance->diagonal().cwiseSqrt();
     text += fmt::format(R"(,"sigma_m":[{:.4f},{:.4f},{:.4f}],"sigma_deg":[{:.4f},{:.4f},{:.4f}])",
-                        sigma[0], sigma[1], sigma[2], sigma[3] * kDegPerRad,
-                        sigma[4] * kDegPerRad, sigma[5] * kDegPerRad);
+                        sigma[0], sigma[1], sigma[2], sigma[3] * kDegPerRad, sigma[4] * kDegPerRad,
+                        sigma[5] * kDegPerRad);
     text += fmt::format(R"(,"cov":[{:.4e}])",
                         fmt::join(covariance->data(), covariance->data() + 36, ","));
   }

@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "foxglove_stream.hpp"
-#include "taiga/view/run_view.hpp"
 #include "online_trees.hpp"
 #include "pose_stream.hpp"
 #include "recording_feed.hpp"
@@ -30,6 +29,7 @@
 #include "taiga/mapping/map_export.hpp"
 #include "taiga/pipeline/self_calibration.hpp"
 #include "taiga/pipeline/slam_system.hpp"
+#include "taiga/view/run_view.hpp"
 
 namespace taiga::pipeline {
 namespace {

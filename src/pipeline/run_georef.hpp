@@ -55,7 +55,7 @@ class GnssRecorder final : public SlamObserver {
   /// georeference had an estimate for it.
   const OnlineGridPose* onlinePoseAt(double t_s) const {
     return !online_poses_.empty() && online_poses_.back().pose.t_s == t_s ? &online_poses_.back()
-                                                                           : nullptr;
+                                                                          : nullptr;
   }
   /// DIR/trajectory_online_epsgNNNN.csv: one row per scan from the first online estimate on;
   /// nothing when there was none.

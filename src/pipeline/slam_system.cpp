@@ -12,9 +12,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-mapping::MappingThreadOptions mappingThreadOptions(
-    const SystemConfig& config, const SlamOptions& options, const mapping::KeyframeStore& store,
-    const std::vector<SlamObserver*>& observers) {
+mapping::MappingThreadOptions mappingThreadOptions(const SystemConfig& config,
+                                                   const SlamOptions& options,
+                                                   const mapping::KeyframeStore& store,
+                                                   const std::vector<SlamObserver*>& observers) {
   mapping::MappingThreadOptions out;
   // The snapshots the odometry follows (step 11), as many as its local map holds.
   if (config.mapping.correct_odometry)
@@ -31,8 +32,8 @@ mapping::MappingThreadOptions mappingThreadOptions(
 void reexpress(ScanOutcome& outcome, const lie::SE3& T_odom_unlevelled) {
   outcome.T_odom_body = T_odom_unlevelled * outcome.T_odom_body;
   for (StampedPose& p : outcome.imu_rate_poses) p.pose = T_odom_unlevelled * p.pose;
-  if (outcome.covariance) outcome.covariance = rotatedCovariance(*outcome.covariance,
-                                                                 T_odom_unlevelled.rotation());
+  if (outcome.covariance)
+    outcome.covariance = rotatedCovariance(*outcome.covariance, T_odom_unlevelled.rotation());
 }
 
 }  // namespace
@@ -43,10 +44,9 @@ SlamSystem::SlamSystem(const SystemConfig& config, SlamOptions options)
       // Keyframe scans go to disk in the body frame as they are made (memory stays flat); only
       // the registration-resolution copy that loop closure registers stays in RAM.
       store_(mapping::KeyframeStore::create(
-          options.keyframe_dir,
-          {.registration_voxel_m = config.odometry.voxel_size_m,
-           .registration_voxel_point =
-               preprocess::voxelRepresentative(config.odometry.voxel_point)})),
+          options.keyframe_dir, {.registration_voxel_m = config.odometry.voxel_size_m,
+                                 .registration_voxel_point = preprocess::voxelRepresentative(
+                                     config.odometry.voxel_point)})),
       mapping_thread_(config.mapping, config.odometry, store_,
                       mappingThreadOptions(config, options, store_, observers_)),
       correction_(std::make_unique<OdometryCorrection>(

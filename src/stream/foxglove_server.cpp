@@ -65,8 +65,7 @@ struct FoxgloveServer::Impl {
 };
 
 void FoxgloveServer::Impl::sendMessage(Handle client, std::uint32_t subscription,
-                                       std::uint64_t t_ns, const std::string& json,
-                                       bool kept) {
+                                       std::uint64_t t_ns, const std::string& json, bool kept) {
   websocketpp::lib::error_code error;
   Server::connection_ptr connection = server.get_con_from_hdl(client, error);
   if (error) return;

@@ -126,7 +126,8 @@ LodTree LodTree::build(LodPoints points, const LodOptions& options) {
   if (n == 0) return tree;
   const std::vector<float>& xyzi = tree.points_.xyzi;
   Eigen::AlignedBox3f box;
-  for (std::size_t i = 0; i < n; ++i) box.extend(Eigen::Vector3f(xyzi[4 * i], xyzi[4 * i + 1], xyzi[4 * i + 2]));
+  for (std::size_t i = 0; i < n; ++i)
+    box.extend(Eigen::Vector3f(xyzi[4 * i], xyzi[4 * i + 1], xyzi[4 * i + 2]));
 
   // A cube around the box, a little larger so that no point lies on its far faces.
   const float edge_m = std::max(box.sizes().maxCoeff(), 1e-3f) * 1.001f;

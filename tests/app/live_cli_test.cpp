@@ -54,7 +54,6 @@ std::filesystem::path liveConfig(const std::filesystem::path& sim, double idle_t
   return path;
 }
 
-
 /// The pose stream's datagrams (live.pose_udp), parsed, collected on a thread until stop().
 class PoseReceiver {
  public:

@@ -34,8 +34,11 @@ std::filesystem::path writeRun(const test::TempDir& dir) {
     writer.close();
   }
   Trajectory walk, keyframes;
-  for (int i = 0; i < 4; ++i) walk.append(10.0 + 0.1 * i, lie::SE3(lie::SO3(), Eigen::Vector3d(1000.0 + i, 2000.0, 1.5)));
-  for (int i = 0; i < 3; ++i) keyframes.append(10.0 + 0.1 * i, lie::SE3(lie::SO3(), Eigen::Vector3d(1000.0 + i, 2000.0, 1.5)));
+  for (int i = 0; i < 4; ++i)
+    walk.append(10.0 + 0.1 * i, lie::SE3(lie::SO3(), Eigen::Vector3d(1000.0 + i, 2000.0, 1.5)));
+  for (int i = 0; i < 3; ++i)
+    keyframes.append(10.0 + 0.1 * i,
+                     lie::SE3(lie::SO3(), Eigen::Vector3d(1000.0 + i, 2000.0, 1.5)));
   io::writeTum(run / "trajectory.tum", walk);
   io::writeTum(run / "keyframes.tum", keyframes);
   std::ofstream(run / "loops.csv")
@@ -43,10 +46,11 @@ std::filesystem::path writeRun(const test::TempDir& dir) {
          "deg,chi2,accepted,note\n"
       << "10.2,2,0,2.0,5.0,0.05,0.01,0.1,1.0,1,\"\"\n"
       << "10.2,2,1,1.0,5.0,0.50,0.01,0.1,1.0,0,\"fitness\"\n";
-  std::ofstream(run / "timing.csv") << "t_s,read_ms,total_ms\n10.0,1,5.5\n10.1,1,6.5\n10.2,1,40\n10.3,1,7\n";
+  std::ofstream(run / "timing.csv")
+      << "t_s,read_ms,total_ms\n10.0,1,5.5\n10.1,1,6.5\n10.2,1,40\n10.3,1,7\n";
   std::ofstream(run / "scans.csv") << "t_s,status\n10.0,ok\n10.1,ok\n10.2,degraded\n10.3,ok\n";
   std::ofstream(run / "trees.csv") << "id,x_m,y_m,z_m,dbh_m\n1,1005.0,2000.5,0.1,0.25\n"
-                                    << "2,1010.0,2001.0,0.2,0.31\n";
+                                   << "2,1010.0,2001.0,0.2,0.31\n";
   std::ofstream(run / "summary.json")
       << R"({"health": {"verdict": "ok", "scans_ok": 3}, "time_per_scan_ms": {"p50": 6.0},
             "realtime_factor": 9.5, "recording": "not passed on"})";

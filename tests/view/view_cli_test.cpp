@@ -36,11 +36,10 @@ std::size_t tumRows(const std::filesystem::path& path) {
   return rows;
 }
 
-
 /// tools/viewer-check's report on the page at `url`, its screenshot written to `png`.
 nlohmann::json checkPage(const std::string& url, const std::filesystem::path& png) {
-  const test::TaigaResult r = test::runCommand(fmt::format(
-      "node tools/viewer-check/viewer-check.mjs {} {} 60 2>&1", url, png.string()));
+  const test::TaigaResult r = test::runCommand(
+      fmt::format("node tools/viewer-check/viewer-check.mjs {} {} 60 2>&1", url, png.string()));
   EXPECT_EQ(r.exit_code, 0) << r.output << " (run scripts/setup.sh)";
   const nlohmann::json report = nlohmann::json::parse(r.output, nullptr, false);
   EXPECT_TRUE(report.is_object()) << r.output;
@@ -63,11 +62,11 @@ TEST(ViewCli, TheViewerShowsAFinishedRunInHeadlessChromium) {
   test::TempDir dir;
   const auto sim = test::simulateCapture(dir);
   const auto run = sim / "run";
-  ASSERT_EQ(test::runTaiga(fmt::format("run {} --config {} --out {}",
-                                       (sim / "recording.bag").string(),
-                                       (sim / "rig.yaml").string(), run.string()))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      test::runTaiga(fmt::format("run {} --config {} --out {}", (sim / "recording.bag").string(),
+                                 (sim / "rig.yaml").string(), run.string()))
+          .exit_code,
+      0);
   // The tree layer: `taiga trees` writes RUN/trees.csv, the viewer draws its stems.
   ASSERT_EQ(test::runTaiga("trees " + run.string()).exit_code, 0);
   const std::size_t stems = tumRows(run / "trees.csv") - 1;  // its rows less the header
@@ -111,11 +110,12 @@ TEST(ViewCli, TheViewerFollowsALiveRun) {
     return test::runTaiga(fmt::format("run --live --config {} --out {} --view {}",
                                       config_path.string(), (sim / "live_run").string(), address));
   });
-  auto page = std::async(std::launch::async,
-                         [&] { return checkPage("http://" + address + "/", dir.file("live.png")); });
+  auto page = std::async(std::launch::async, [&] {
+    return checkPage("http://" + address + "/", dir.file("live.png"));
+  });
   std::this_thread::sleep_for(std::chrono::seconds(1));  // until it listens
-  const test::TaigaResult replay = test::runTaiga(fmt::format(
-      "replay {} --rate 1 --port-offset {}", (sim / "capture.pcap").string(), offset));
+  const test::TaigaResult replay = test::runTaiga(
+      fmt::format("replay {} --rate 1 --port-offset {}", (sim / "capture.pcap").string(), offset));
   ASSERT_EQ(replay.exit_code, 0) << replay.output;
   const test::TaigaResult run = live.get();
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -139,10 +139,12 @@ TEST(ViewCli, WhatCannotBeServedIsNamed) {
   EXPECT_THAT(no_map.output, HasSubstr("without map.las"));
 
   // A cloud to serve: the simulator's reference of the forest is not needed, any PLY will do.
-  std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                    "property float z\nend_header\n1 2 3\n4 5 6\n7 8 9\n";
+  std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n1 2 3\n4 5 6\n7 8 9\n";
   const auto cloud = dir.write("cloud.ply", ply);
-  const test::TaigaResult bad_bind = test::runTaiga(fmt::format("view {} --bind nowhere", cloud.string()));
+  const test::TaigaResult bad_bind =
+      test::runTaiga(fmt::format("view {} --bind nowhere", cloud.string()));
   EXPECT_EQ(bad_bind.exit_code, 2);
   EXPECT_THAT(bad_bind.output, HasSubstr("--bind: expected host:port"));
 
