@@ -327,6 +327,7 @@ async function showRun(info) {
   }
   const ms = info.scans.ms, status = info.scans.status;
   state.scans = ms.length;
+  chart.style.display = ms.length > 0 ? "" : "none";  // a cloud file has no scans
   if (ms.length > 0) {
     const sorted = [...ms].sort((a, b) => a - b);
     setText("timing", `time per scan: median ${median(ms).toFixed(1)} ms, ` +

@@ -10,6 +10,7 @@
 #include "taiga/core/errors.hpp"
 #include "taiga/core/progress.hpp"
 #include "taiga/sim/realism.hpp"
+#include "taiga/sim/als.hpp"
 #include "taiga/sim/reference_cloud.hpp"
 #include "taiga/sim/scenario_yaml.hpp"
 #include "taiga/sim/simulator.hpp"
@@ -29,6 +30,7 @@ struct SimulateOptions {
   std::optional<std::string> pcap_profile;  // also capture.pcap + capture.json
   bool reference_cloud = false;        // also write reference_cloud.las (a TLS survey)
   sim::ReferenceCloudParams reference;
+  std::optional<double> als_pulses_per_m2;  // also write als.las (an airborne survey)
 };
 
 int runSimulate(const SimulateOptions& options) {
@@ -77,6 +79,19 @@ int runSimulate(const SimulateOptions& options) {
         reference.points, reference.stations, reference.rays,
         static_cast<double>(reference.file_bytes) / 1e6,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_reference).count());
+  }
+  if (options.als_pulses_per_m2) {
+    const auto start_als = std::chrono::steady_clock::now();
+    const std::filesystem::path path = std::filesystem::path(options.out) / "als.las";
+    const sim::AlsSummary als =
+        sim::writeAls(simulation, path, {.pulses_per_m2 = *options.als_pulses_per_m2});
+    fmt::print(
+        "wrote {}: {} points of {} pulses over {:.2f} ha ({} last returns, {} ground; {:.0f} MB) "
+        "in EPSG:{} in {:.1f} s\n",
+        path.string(), als.points, als.pulses, als.area_m2 / 1e4, als.last_returns,
+        als.ground_points, static_cast<double>(als.file_bytes) / 1e6,
+        scenario.gnss.georef_epsg,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_als).count());
   }
   return kExitOk;
 }
@@ -148,6 +163,14 @@ Command addSimulateCommand(CLI::App& tool) {
                    "Voxel size thinning the reference cloud, m (0: keep every return)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  parser
+      ->add_option("--als", options->als_pulses_per_m2,
+                   "Also write als.las: the plot as an airborne laser scanner records it (this many "
+                   "pulses per m^2, first and last returns, ground classified) in the projected "
+                   "CRS of georef_truth.yaml")
+      ->expected(0, 1)
+      ->default_str("5")
+      ->check(CLI::Range(0.1, 1000.0));
   return {parser, [options] { return runSimulate(*options); }, options};
 }
 

@@ -108,8 +108,7 @@ void LasWriter::writeHeader() {
   h.put<std::uint64_t>(0);  // start of first extended VLR
   h.put<std::uint32_t>(0);  // number of extended VLRs
   h.put<std::uint64_t>(count_);
-  h.put<std::uint64_t>(count_);  // points by return: all are first (and only) returns
-  h.putZeros(14 * 8);
+  for (std::uint64_t n : points_by_return_) h.put<std::uint64_t>(n);  // points by return
   if (has_wkt) {
     h.put<std::uint16_t>(0);  // reserved
     h.putText("LASF_Projection", 16);
@@ -135,9 +134,22 @@ void LasWriter::append(const PointCloud& cloud, std::span<const std::uint8_t> cl
   appendRecords(cloud, classifications, source_ids, 0);
 }
 
+void LasWriter::append(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
+                       std::span<const std::uint16_t> source_ids,
+                       std::span<const std::array<std::uint8_t, 2>> returns) {
+  if (classifications.size() != cloud.size() || source_ids.size() != cloud.size() ||
+      returns.size() != cloud.size())
+    throw std::logic_error("LasWriter::append: one classification, source ID and return per point");
+  for (const auto& [number, of] : returns)
+    if (number < 1 || number > of || of > 15)
+      throw std::logic_error("LasWriter::append: a return number outside 1..number of returns");
+  appendRecords(cloud, classifications, source_ids, 0, returns);
+}
+
 void LasWriter::appendRecords(const PointCloud& cloud,
                               std::span<const std::uint8_t> classifications,
-                              std::span<const std::uint16_t> source_ids, std::uint16_t source_id) {
+                              std::span<const std::uint16_t> source_ids, std::uint16_t source_id,
+                              std::span<const std::array<std::uint8_t, 2>> returns) {
   if (closed_) throw std::logic_error("LasWriter::append after close");
   if (cloud.empty()) return;
   if (!offset_set_) {
@@ -163,7 +175,11 @@ void LasWriter::appendRecords(const PointCloud& cloud,
     const float intensity = cloud.hasIntensities() ? cloud.intensities[i] : 0.0f;
     records.put<std::uint16_t>(
         static_cast<std::uint16_t>(std::clamp(std::round(intensity), 0.0f, 65535.0f)));
-    records.put<std::uint8_t>(0x11);  // return 1 of 1
+    // Return number (bits 0-3) and number of returns (bits 4-7): 1 of 1 unless given.
+    const std::uint8_t number = returns.empty() ? 1 : returns[i][0];
+    records.put<std::uint8_t>(
+        static_cast<std::uint8_t>(number | (returns.empty() ? 1 : returns[i][1]) << 4));
+    ++points_by_return_[number - 1];
     records.put<std::uint8_t>(0);     // classification flags, scanner channel, scan direction, edge
     records.put<std::uint8_t>(classifications.empty() ? options_.classification
                                                       : classifications[i]);

@@ -120,10 +120,11 @@ json infoJson(const fs::path& input, bool run_dir, const LodTree& tree) {
                {"keyframes", json::array()},
                {"loops", json::array()},
                {"scans", scansJson(run_dir ? input : fs::path())},
-               {"trees", treesJson((run_dir ? input : input.parent_path()) / "trees.csv", origin)},
+               {"trees", json::array()},
                {"summary", json::object()}};
   if (!run_dir) return info;
   info["trajectory"] = trajectoryJson(input / "trajectory.tum", origin);
+  info["trees"] = treesJson(input / "trees.csv", origin);
   if (fs::exists(input / "keyframes.tum")) {
     const Trajectory keyframes = io::readTum(input / "keyframes.tum");
     for (const StampedPose& k : keyframes.poses())

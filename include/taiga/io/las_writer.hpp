@@ -10,6 +10,7 @@
 // WKT bit of the global encoding, as LAS 1.4 requires for formats 6 and above.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -50,6 +51,12 @@ class LasWriter {
   /// and tree ids from `taiga trees`); both spans as long as the cloud.
   void append(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
               std::span<const std::uint16_t> source_ids);
+  /// The same with the returns of multi-return sensors (airborne lidar): per point its return
+  /// number and the pulse's number of returns (1-15), e.g. {1, 2} and {2, 2} for the first and
+  /// last of two; every span as long as the cloud.
+  void append(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
+              std::span<const std::uint16_t> source_ids,
+              std::span<const std::array<std::uint8_t, 2>> returns);
   /// Writes the final header; also done by the destructor (which cannot report errors).
   void close();
 
@@ -59,7 +66,8 @@ class LasWriter {
  private:
   void writeHeader();
   void appendRecords(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
-                     std::span<const std::uint16_t> source_ids, std::uint16_t source_id);
+                     std::span<const std::uint16_t> source_ids, std::uint16_t source_id,
+                     std::span<const std::array<std::uint8_t, 2>> returns = {});
 
   std::filesystem::path path_;
   LasOptions options_;
@@ -67,6 +75,7 @@ class LasWriter {
   Eigen::Vector3d offset_m_ = Eigen::Vector3d::Zero();
   bool offset_set_ = false;
   std::uint64_t count_ = 0;
+  std::array<std::uint64_t, 15> points_by_return_{};
   Eigen::Vector3d min_m_, max_m_;
   std::uint32_t point_data_offset_ = 0;
   bool closed_ = false;
