@@ -8,6 +8,9 @@
 
 #include <array>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "../support/temp_dir.hpp"
@@ -118,6 +121,45 @@ TEST(LasWriter, RejectsCoordinatesBeyondTheIntegerRange) {
   EXPECT_THAT(messageOf<InputError>([&] { writer.append(cloud); }),
               HasSubstr("coordinate 6672118.4 m does not fit LAS's 32-bit range at scale 0.001 m around offset 0 m"));
   EXPECT_THAT(messageOf<InputError>([&] { LasWriter(dir.file("missing/dir/x.las")); }), HasSubstr("cannot open for writing"));
+}
+
+}  // namespace
+}  // namespace taiga::io
+
+namespace taiga::io {
+namespace {
+
+// Airborne lidar's returns (sim/als.hpp): each point's return byte, and the header's points by
+// return (15 counts at byte 255 of a LAS 1.4 header).
+TEST(LasWriter, WritesReturnNumbersAndCountsThemInTheHeader) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.positions = {{1.0, 2.0, 30.0}, {1.0, 2.0, 10.0}, {5.0, 6.0, 10.0}};
+  const std::vector<std::uint8_t> classes = {1, 2, 2};
+  const std::vector<std::uint16_t> ids(3, 0);
+  const std::vector<std::array<std::uint8_t, 2>> returns = {{1, 2}, {2, 2}, {1, 1}};
+  const auto path = dir.file("returns.las");
+  {
+    LasWriter writer(path);
+    writer.append(cloud, classes, ids, returns);
+    writer.close();
+  }
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::uint64_t by_return[15];
+  std::memcpy(by_return, bytes.data() + 255, sizeof(by_return));
+  EXPECT_EQ(by_return[0], 2u);
+  EXPECT_EQ(by_return[1], 1u);
+  std::uint32_t offset = 0;
+  std::memcpy(&offset, bytes.data() + 96, 4);
+  EXPECT_EQ(static_cast<std::uint8_t>(bytes[offset + 14]), 0x21);       // 1 of 2
+  EXPECT_EQ(static_cast<std::uint8_t>(bytes[offset + 30 + 14]), 0x22);  // 2 of 2
+  EXPECT_EQ(static_cast<std::uint8_t>(bytes[offset + 60 + 14]), 0x11);  // 1 of 1
+  EXPECT_EQ(bytes[offset + 30 + 16], 2);                                // ground
+
+  LasWriter bad(dir.file("bad.las"));
+  const std::vector<std::array<std::uint8_t, 2>> third_of_two = {{3, 2}, {1, 1}, {1, 1}};
+  EXPECT_THROW(bad.append(cloud, classes, ids, third_of_two), std::logic_error);
 }
 
 }  // namespace
