@@ -98,8 +98,19 @@ int runTrees(const TreesOptions& options) {
   trees::writeAsciiGrid(out / "dtm.asc", inventory.terrain, offset_m);
   if (!options.no_map) {
     const trees::PointLabels labels = trees::labelPoints(local, inventory, io_options.terrain);
-    io::LasWriter writer(out / "trees_map.las", {.wkt = wkt});
-    writer.append(cloud, labels.classification, labels.tree_id);
+    // Every point's height above the DTM, as a LAS extra field (the height-normalised map that
+    // lidR's normalize_height or 3DFin work on).
+    std::vector<float> above_ground_m(local.size());
+    for (std::size_t i = 0; i < local.size(); ++i)
+      above_ground_m[i] = static_cast<float>(
+          local[i].z() - inventory.terrain.heightAt(local[i].x(), local[i].y()));
+    io::LasWriter writer(out / "trees_map.las",
+                         {.wkt = wkt,
+                          .extra_float_name = "HeightAboveGround",
+                          .extra_float_description = "height above the DTM, m"});
+    writer.append(cloud, {.classifications = labels.classification,
+                          .source_ids = labels.tree_id,
+                          .extra = above_ground_m});
     writer.close();
   }
 

@@ -152,8 +152,7 @@ AlsSummary writeAls(const Simulation& simulation, const std::filesystem::path& p
   for (std::uint8_t c : als.classifications) summary.ground_points += c == kGroundClass ? 1 : 0;
   {
     io::LasWriter writer(path, {.wkt = geo::CoordinateConverter(truth.epsg).wkt()});
-    const std::vector<std::uint16_t> source_ids(als.cloud.size(), 0);
-    writer.append(als.cloud, als.classifications, source_ids, als.returns);
+    writer.append(als.cloud, {.classifications = als.classifications, .returns = als.returns});
     writer.close();
   }
   summary.file_bytes = std::filesystem::file_size(path);

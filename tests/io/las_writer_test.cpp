@@ -141,7 +141,7 @@ TEST(LasWriter, WritesReturnNumbersAndCountsThemInTheHeader) {
   const auto path = dir.file("returns.las");
   {
     LasWriter writer(path);
-    writer.append(cloud, classes, ids, returns);
+    writer.append(cloud, {.classifications = classes, .source_ids = ids, .returns = returns});
     writer.close();
   }
   std::ifstream in(path, std::ios::binary);
@@ -159,7 +159,7 @@ TEST(LasWriter, WritesReturnNumbersAndCountsThemInTheHeader) {
 
   LasWriter bad(dir.file("bad.las"));
   const std::vector<std::array<std::uint8_t, 2>> third_of_two = {{3, 2}, {1, 1}, {1, 1}};
-  EXPECT_THROW(bad.append(cloud, classes, ids, third_of_two), std::logic_error);
+  EXPECT_THROW(bad.append(cloud, {.returns = third_of_two}), std::logic_error);
 }
 
 }  // namespace

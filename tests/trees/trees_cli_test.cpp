@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "../support/run_taiga.hpp"
 #include "../support/temp_dir.hpp"
@@ -61,6 +62,27 @@ TEST(TreesCli, TheRealPinePlot) {
     EXPECT_LT(t.dbh_m, 0.45);
     EXPECT_NEAR(t.ground_z_m, 49.5, 1.5);
   }
+
+  // Every point's height above the ground, read back by an independent LAS reader (copc.js,
+  // tools/las-check): a LAS 1.4 extra field; ground points at 0, every point's z less its height
+  // on the plot's terrain.
+  const auto check = test::runCommand("node tools/las-check/las-check.mjs " +
+                                      dir.file("trees_map.las").string() + " 3000");
+  ASSERT_EQ(check.exit_code, 0) << check.output << " (run scripts/setup.sh)";
+  const nlohmann::json las = nlohmann::json::parse(check.output);
+  EXPECT_EQ(las["pointDataRecordLength"], 34);
+  ASSERT_EQ(las["extraBytes"].size(), 1u);
+  EXPECT_EQ(las["extraBytes"][0]["name"], "HeightAboveGround");
+  std::size_t ground = 0, ground_near = 0;
+  for (const nlohmann::json& p : las["points"]) {
+    const double z = p["Z"], above = p["HeightAboveGround"];
+    EXPECT_NEAR(z - above, 49.5, 1.5);
+    if (p["Classification"] != 2) continue;
+    ++ground;
+    ground_near += std::abs(above) < 0.15;
+  }
+  EXPECT_GT(ground, 100u);
+  EXPECT_GT(ground_near, ground * 95 / 100);
 }
 
 TEST(TreesCli, ACloudWithoutGroundSaysSo) {

@@ -1,5 +1,6 @@
 // Reads a LAS file with copc.js (an LAS 1.2/1.4 reader written by the PDAL developers) and prints
-// what it finds as JSON: the header, the VLRs (with a WKT record's text) and the first points.
+// what it finds as JSON: the header, the VLRs (with a WKT record's text), the extra bytes'
+// descriptions and the first points (with their extra fields).
 // taiga's tests compare this with what taiga wrote, so that taiga's LAS writer is checked by a
 // reader it shares no code with. Usage: node las-check.mjs FILE [MAX_POINTS]
 import { readFileSync } from 'node:fs';
@@ -11,7 +12,11 @@ const bytes = new Uint8Array(readFileSync(path));
 const header = Las.Header.parse(bytes.subarray(0, 375));
 const vlrs = await Las.Vlr.walk(async (begin, end) => bytes.subarray(begin, end), header);
 const vlrInfo = [];
+let extraBytes = [];
 for (const vlr of vlrs) {
+  if (vlr.userId === 'LASF_Spec' && vlr.recordId === 4) {
+    extraBytes = Las.ExtraBytes.parse(bytes.subarray(vlr.contentOffset, vlr.contentOffset + vlr.contentLength));
+  }
   const info = { userId: vlr.userId, recordId: vlr.recordId, length: vlr.contentLength };
   if (vlr.userId === 'LASF_Projection' && vlr.recordId === 2112) {
     const content = bytes.subarray(vlr.contentOffset, vlr.contentOffset + vlr.contentLength);
@@ -21,9 +26,9 @@ for (const vlr of vlrs) {
 }
 const count = Number(header.pointCount);
 const data = bytes.subarray(header.pointDataOffset, header.pointDataOffset + count * header.pointDataRecordLength);
-const view = Las.View.create(data, header);
+const view = Las.View.create(data, header, extraBytes);
 const names = ['X', 'Y', 'Z', 'Intensity', 'ReturnNumber', 'NumberOfReturns', 'Classification', 'UserData',
-  'PointSourceId', 'GpsTime'];
+  'PointSourceId', 'GpsTime', ...extraBytes.map((eb) => eb.name)];
 const get = Object.fromEntries(names.map((n) => [n, view.getter(n)]));
 const points = [];
 for (let i = 0; i < Math.min(count, Number(maxPointsText)); ++i) {
@@ -36,5 +41,5 @@ console.log(JSON.stringify({
   pointCount: count,
   globalEncoding: header.globalEncoding,
   scale: header.scale, offset: header.offset, min: header.min, max: header.max,
-  vlrs: vlrInfo, points,
+  vlrs: vlrInfo, extraBytes, points,
 }, null, 1));

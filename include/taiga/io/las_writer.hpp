@@ -32,8 +32,21 @@ struct LasOptions {
   std::string wkt;
   std::string system_identifier = "taiga";
   std::string generating_software = "taiga";
+  /// Non-empty: one float32 per point after the standard fields, described by a LAS 1.4 Extra
+  /// Bytes VLR with this name (at most 31 characters, e.g. "HeightAboveGround") and description.
+  std::string extra_float_name, extra_float_description;
   /// ASPRS class written for every point (1 = unclassified).
   std::uint8_t classification = 1;
+};
+
+/// Per-point fields beyond the cloud's channels.
+struct LasPointFields {
+  std::span<const std::uint8_t> classifications;  ///< ASPRS class
+  std::span<const std::uint16_t> source_ids;      ///< point source ID
+  /// Return number and the pulse's number of returns (1-15), e.g. {1, 2} and {2, 2} for the
+  /// first and last of two (multi-return sensors, airborne lidar).
+  std::span<const std::array<std::uint8_t, 2>> returns;
+  std::span<const float> extra;  ///< the LasOptions::extra_float field's value
 };
 
 class LasWriter {
@@ -51,12 +64,10 @@ class LasWriter {
   /// and tree ids from `taiga trees`); both spans as long as the cloud.
   void append(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
               std::span<const std::uint16_t> source_ids);
-  /// The same with the returns of multi-return sensors (airborne lidar): per point its return
-  /// number and the pulse's number of returns (1-15), e.g. {1, 2} and {2, 2} for the first and
-  /// last of two; every span as long as the cloud.
-  void append(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
-              std::span<const std::uint16_t> source_ids,
-              std::span<const std::array<std::uint8_t, 2>> returns);
+  /// The same with any per-point field; an empty span takes the default (class
+  /// LasOptions::classification, source ID 0, return 1 of 1, extra value 0); a given one must be
+  /// as long as the cloud.
+  void append(const PointCloud& cloud, const LasPointFields& fields);
   /// Writes the final header; also done by the destructor (which cannot report errors).
   void close();
 
@@ -65,9 +76,8 @@ class LasWriter {
 
  private:
   void writeHeader();
-  void appendRecords(const PointCloud& cloud, std::span<const std::uint8_t> classifications,
-                     std::span<const std::uint16_t> source_ids, std::uint16_t source_id,
-                     std::span<const std::array<std::uint8_t, 2>> returns = {});
+  void appendRecords(const PointCloud& cloud, const LasPointFields& fields,
+                     std::uint16_t source_id);
 
   std::filesystem::path path_;
   LasOptions options_;
