@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "command.hpp"
+#include "georef_als.hpp"
 #include "recording_options.hpp"
 #include "taiga/core/angles.hpp"
 #include "taiga/core/errors.hpp"
@@ -22,9 +23,19 @@ struct GeorefOptions {
   std::string method;  ///< empty: not given
   std::optional<int> epsg;
   std::optional<double> max_horizontal_sigma_m, max_gap_s;
+  AlsGeorefOptions als;
 };
 
 int runGeoref(const GeorefOptions& options) {
+  if (!options.als.als.empty()) {
+    if (options.als.run.empty()) throw InputError("taiga georef --als: give the run: --run RUN_DIR");
+    AlsGeorefOptions als = options.als;
+    als.out = options.out;
+    als.epsg = options.epsg;
+    return runAlsGeoref(als);
+  }
+  if (options.trajectory.empty() || options.gnss.empty())
+    throw InputError("taiga georef: give --traj and --gnss (GNSS fixes), or --als and --run");
   const SystemConfig config = loadConfig(options.config);
   const Trajectory trajectory = io::readTrajectory(options.trajectory);
   const georef::GnssInput input = georef::readGnssInput(options.gnss, config);
@@ -65,10 +76,24 @@ Command addGeorefCommand(CLI::App& tool) {
   auto options = std::make_shared<GeorefOptions>();
   CLI::App* parser = tool.add_subcommand(
       "georef", "Fit a trajectory to GNSS fixes and write it in a projected coordinate system");
-  parser->add_option("--traj", options->trajectory, "Trajectory to georeference (TUM or KITTI), T_world_body")
-      ->required();
-  parser->add_option("--gnss", options->gnss, "Recording, or CSV file of fixes (docs/georeferencing.md)")
-      ->required();
+  parser->add_option("--traj", options->trajectory,
+                     "Trajectory to georeference (TUM or KITTI), T_world_body");
+  parser->add_option("--gnss", options->gnss,
+                     "Recording, or CSV file of fixes (docs/georeferencing.md)");
+  parser->add_option("--als", options->als.als,
+                     "Instead of GNSS: airborne lidar tiles (LAS in the grid, or directories of "
+                     "them) to register the map of --run to (docs/georeferencing.md, ALS)");
+  parser->add_option("--run", options->als.run, "With --als: the run directory of `taiga run`");
+  parser->add_option("--guess", options->als.guess,
+                     "With --als: the map origin's E,N and heading (deg from grid east), when the "
+                     "run has no GNSS georeference (default: RUN/georef/georef.yaml)");
+  parser->add_option("--search-m", options->als.search_m,
+                     "With --als: half width of the position search, m (default 8 from GNSS, 25 "
+                     "from --guess)")
+      ->check(CLI::PositiveNumber);
+  parser->add_option("--search-deg", options->als.search_deg,
+                     "With --als: half width of the heading search, deg (default 8 / 25)")
+      ->check(CLI::Range(0.5, 180.0));
   parser->add_option("--method", options->method,
                      "Fitting method (default: georef.method of --config, robust)")
       ->check(CLI::IsMember({"closed", "pf3", "pf6", "robust"}));

@@ -383,3 +383,101 @@ TEST(GeorefCli, TaigaRunGeoreferencesItsTrajectoryAndMapWhenTheRecordingHasFixes
 
 }  // namespace
 }  // namespace taiga
+
+namespace taiga {
+namespace {
+
+/// Mean errors of a grid trajectory (trajectory_epsg3067.csv of a run's poses) against the
+/// simulator's truth, poses matched by time: horizontal (m), height (m, signed), heading (deg,
+/// signed). The run's own odometry error is in them (centimetres).
+struct GridErrors {
+  double horizontal_m = 0.0, height_m = 0.0, heading_deg = 0.0;
+  std::size_t poses = 0;
+};
+
+GridErrors gridErrors(const std::filesystem::path& sim_dir, const std::filesystem::path& csv_path) {
+  const YAML::Node truth = YAML::LoadFile((sim_dir / "georef_truth.yaml").string());
+  const Eigen::Matrix4d T_epsg_world = matrixOf(truth["T_epsg_world"]);
+  const Trajectory groundtruth = io::readTum(sim_dir / "groundtruth.tum");
+  std::ifstream csv(csv_path);
+  std::string line;
+  std::getline(csv, line);
+  GridErrors e;
+  while (std::getline(csv, line)) {
+    std::vector<double> v;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) v.push_back(std::stod(cell));
+    const std::optional<lie::SE3> pose = groundtruth.tryPoseAt(v.at(0));
+    if (!pose) continue;
+    const Eigen::Vector3d grid = (T_epsg_world * pose->translation().homogeneous()).head<3>();
+    e.horizontal_m += std::hypot(v[1] - grid.x(), v[2] - grid.y());
+    e.height_m += v[3] - grid.z();
+    e.heading_deg += std::remainder(
+        v[4] - pose->rotation().yaw() * kDegPerRad - truth["yaw_grid_world_deg"].as<double>(),
+        360.0);
+    ++e.poses;
+  }
+  EXPECT_GT(e.poses, 100u);
+  const double n = static_cast<double>(std::max<std::size_t>(e.poses, 1));
+  e.horizontal_m /= n;
+  e.height_m /= n;
+  e.heading_deg /= n;
+  return e;
+}
+
+// Issue 23: a run's map registered to the simulated airborne survey (5 pulses per m^2) places
+// the walk to centimetres in the grid, from the run's canopy GNSS georeference (metres off) and
+// from a user's rough pose 20 m and 18 deg off without GNSS; what cannot be registered is named.
+TEST(GeorefCli, AlsPlacesTheRunsMapToDecimetresFromGnssAndFromARoughPose) {
+  test::TempDir dir;
+  const auto sim = dir.file("sim");
+  ASSERT_EQ(runTaiga("simulate --scenario handheld-loop --duration 30 --beams 32 --columns 512 "
+                     "--seed 6 --als --out " + sim.string())
+                .exit_code,
+            0);
+  const auto run = dir.file("run");
+  const test::TaigaResult ran = runTaiga("run " + (sim / "recording.bag").string() + " --config " +
+                                         (sim / "rig.yaml").string() + " --out " + run.string());
+  ASSERT_EQ(ran.exit_code, 0) << ran.output;
+  const GridErrors gnss = gridErrors(sim, run / "georef" / "trajectory_epsg3067.csv");
+
+  const auto from_gnss = dir.file("als_gnss");
+  const test::TaigaResult r = runTaiga("georef --als " + (sim / "als.las").string() + " --run " +
+                                       run.string() + " --out " + from_gnss.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const GridErrors als = gridErrors(sim, from_gnss / "trajectory_epsg3067.csv");
+  EXPECT_LT(als.horizontal_m, 0.2) << "GNSS alone: " << gnss.horizontal_m << " m";
+  EXPECT_LT(std::abs(als.height_m), 0.1) << "GNSS alone: " << gnss.height_m << " m";
+  EXPECT_LT(std::abs(als.heading_deg), 0.2) << "GNSS alone: " << gnss.heading_deg << " deg";
+  EXPECT_TRUE(std::filesystem::exists(from_gnss / "map_epsg3067.las"));
+  EXPECT_TRUE(std::filesystem::exists(from_gnss / "trajectory.geojson"));
+
+  // Without GNSS: the map's origin 20 m and 18 deg from where the ALS put it.
+  const YAML::Node report = YAML::LoadFile((from_gnss / "georef_als.yaml").string());
+  ASSERT_TRUE(report["ok"].as<bool>());
+  const Eigen::Matrix4d T = matrixOf(report["T_epsg_world"]);
+  const double yaw_deg = std::atan2(T(1, 0), T(0, 0)) * kDegPerRad;
+  const auto from_guess = dir.file("als_guess");
+  const test::TaigaResult guessed = runTaiga(fmt::format(
+      "georef --als {} --run {} --guess {:.3f},{:.3f},{:.3f} --out {}", (sim / "als.las").string(),
+      run.string(), T(0, 3) + 16.0, T(1, 3) - 12.0, yaw_deg + 18.0, from_guess.string()));
+  ASSERT_EQ(guessed.exit_code, 0) << guessed.output;
+  const GridErrors rough = gridErrors(sim, from_guess / "trajectory_epsg3067.csv");
+  EXPECT_LT(rough.horizontal_m, 0.2);
+  EXPECT_LT(std::abs(rough.height_m), 0.1);
+  EXPECT_LT(std::abs(rough.heading_deg), 0.2);
+
+  // A start the tile does not cover, and a missing run.
+  const test::TaigaResult far = runTaiga(fmt::format(
+      "georef --als {} --run {} --guess {:.3f},{:.3f},0 --out {}", (sim / "als.las").string(),
+      run.string(), T(0, 3) + 2000.0, T(1, 3), dir.file("far").string()));
+  EXPECT_EQ(far.exit_code, 2);
+  EXPECT_THAT(far.output, HasSubstr("no ALS tile of 1 overlaps the map"));
+  const test::TaigaResult no_run =
+      runTaiga("georef --als " + (sim / "als.las").string() + " --out " + dir.file("x").string());
+  EXPECT_EQ(no_run.exit_code, 2);
+  EXPECT_THAT(no_run.output, HasSubstr("--run RUN_DIR"));
+}
+
+}  // namespace
+}  // namespace taiga
