@@ -59,7 +59,6 @@ TEST(AlsRegistration, FromAGnssGuessTheMapIsPlacedToDecimetres) {
     EXPECT_LT(std::abs(error.rotation().Log().z()) * kDegPerRad, 0.2);
     EXPECT_GT(r.coverage, 0.5);
     EXPECT_GT(r.sigma.head<3>().minCoeff(), 0.0);
-    std::printf("error %.3f %.3f %.3f m, yaw %.3f deg; sigma %.3f %.3f %.3f m %.3f deg; coverage %.2f score %.3f second %.3f\n", t.x(), t.y(), t.z(), error.rotation().Log().z() * kDegPerRad, r.sigma[0], r.sigma[1], r.sigma[2], r.sigma[5] * kDegPerRad, r.coverage, r.score, r.second_score);
   }
 }
 
@@ -71,7 +70,6 @@ TEST(AlsRegistration, WithoutGnssFromARoughPose20mAnd20degOff) {
   ASSERT_TRUE(r.ok) << r.reason;
   const lie::SE3 error = p.T_grid_world.inverse() * r.T_grid_map;
   const Eigen::Vector3d t = p.T_grid_world.rotation() * error.translation();
-  std::printf("error %.3f %.3f %.3f m, yaw %.3f deg; coverage %.2f score %.3f second %.3f\n", t.x(), t.y(), t.z(), error.rotation().Log().z() * kDegPerRad, r.coverage, r.score, r.second_score);
   EXPECT_LT(t.head<2>().norm(), 0.2) << t.transpose();
   EXPECT_LT(std::abs(t.z()), 0.1) << t.transpose();
   EXPECT_LT(std::abs(error.rotation().Log().z()) * kDegPerRad, 0.2);
