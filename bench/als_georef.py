@@ -1,0 +1,117 @@
+#!/usr/bin/python3
+"""ALS georeferencing against the simulator's truth (issue 23, bench/BENCHMARK.md "Session 38").
+
+For each scenario and seed: `taiga simulate --als` (5 pulses per m^2), `taiga run` with the
+rig.yaml a user would write, then `taiga georef --als` twice: from a start 5 m and 5 deg off the
+true pose of the map (searching 8 m / 8 deg, as from GNSS) and from one 20 m and 20 deg off
+(searching 25 m / 25 deg, without GNSS). The true pose of the map in the grid is the simulator's
+T_epsg_world times the run's map frame aligned to the ground truth (Kabsch on positions).
+Prints one JSON line per run and a Markdown table: mean errors of the grid trajectory (horizontal,
+height, heading), and how often the reported 1-sigma covered the transform's error (east, north,
+up, yaw) within 1 and 2 sigma.
+
+Usage: bench/als_georef.py OUT_DIR [SEEDS] [SCENARIOS]   (environment: TAIGA, DURATION, BEAMS)
+Example: bench/als_georef.py /tmp/als_bench "21 22 23" "handheld-loop harvester"
+"""
+import json, math, os, subprocess, sys
+import numpy as np
+import yaml
+
+taiga = os.environ.get("TAIGA", "build/bin/taiga")
+duration = os.environ.get("DURATION", "60")
+beams = os.environ.get("BEAMS", "32")
+out = sys.argv[1]
+seeds = (sys.argv[2] if len(sys.argv) > 2 else "21 22 23").split()
+scenarios = (sys.argv[3] if len(sys.argv) > 3 else "handheld-loop harvester").split()
+
+
+def tum(path):
+    rows = [list(map(float, l.split())) for l in open(path) if l.strip() and not l.startswith("#")]
+    return {round(r[0], 4): np.array(r[1:4]) for r in rows}, rows
+
+
+def yaw_of(q):  # x y z w
+    x, y, z, w = q
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def true_grid_pose(sim, run):
+    """T_grid_map of the run's map frame: the truth's T_epsg_world times T_world_map (Kabsch)."""
+    truth = yaml.safe_load(open(f"{sim}/georef_truth.yaml"))
+    T_gw = np.array(truth["T_epsg_world"])
+    gt, _ = tum(f"{sim}/groundtruth.tum")
+    est, _ = tum(f"{run}/trajectory.tum")
+    pairs = [(est[t], gt[t]) for t in est if t in gt]
+    A = np.array([p[0] for p in pairs]); B = np.array([p[1] for p in pairs])
+    ca, cb = A.mean(0), B.mean(0)
+    U, _, Vt = np.linalg.svd((A - ca).T @ (B - cb))
+    D = np.diag([1, 1, np.sign(np.linalg.det(Vt.T @ U.T))])
+    R = Vt.T @ D @ U.T
+    T_wm = np.eye(4); T_wm[:3, :3] = R; T_wm[:3, 3] = cb - R @ ca
+    return T_gw @ T_wm
+
+
+def georef(sim, run, dest, T_true, shift_m, turn_deg, search, seed):
+    rng = np.random.default_rng(seed)
+    direction = rng.uniform(0, 2 * math.pi)
+    e = T_true[0, 3] + shift_m * math.cos(direction)
+    n = T_true[1, 3] + shift_m * math.sin(direction)
+    yaw = math.degrees(math.atan2(T_true[1, 0], T_true[0, 0])) + turn_deg * rng.choice([-1, 1])
+    cmd = [taiga, "georef", "--als", f"{sim}/als.las", "--run", run, "--guess",
+           f"{e:.3f},{n:.3f},{yaw:.3f}", "--search-m", str(search), "--search-deg", str(search),
+           "--out", dest]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    report = yaml.safe_load(open(f"{dest}/georef_als.yaml"))
+    result = {"ok": report["ok"], "reason": report.get("reason", "")}
+    if not report["ok"]:
+        return result
+    errors = json.loads(subprocess.run(["python3", "bench/georef_error.py", sim,
+                                        f"{dest}/trajectory_epsg3067.csv"],
+                                       capture_output=True, text=True).stdout)
+    T = np.array(report["T_epsg_world"])
+    d = T[:3, 3] - T_true[:3, 3]
+    dyaw = math.degrees(math.atan2(T[1, 0], T[0, 0]) - math.atan2(T_true[1, 0], T_true[0, 0]))
+    dyaw = (dyaw + 180) % 360 - 180
+    sigma = report["sigma"]
+    result.update(errors)
+    result["transform_error"] = [d[0], d[1], d[2], dyaw]
+    result["sigma"] = [sigma[0], sigma[1], sigma[2], sigma[5]]
+    return result
+
+
+results = []
+for scenario in scenarios:
+    for seed in seeds:
+        base = f"{out}/{scenario}_{seed}"
+        sim, run = f"{base}/sim", f"{base}/run"
+        if not os.path.exists(f"{sim}/als.las"):
+            subprocess.run([taiga, "simulate", "--scenario", scenario, "--duration", duration,
+                            "--beams", beams, "--seed", seed, "--als", "--out", sim],
+                           check=True, capture_output=True)
+        if not os.path.exists(f"{run}/map.las"):
+            subprocess.run([taiga, "run", f"{sim}/recording.bag", "--config", f"{sim}/rig.yaml",
+                            "--out", run], capture_output=True)
+        T_true = true_grid_pose(sim, run)
+        for start, shift, turn, search in [("5 m / 5 deg", 5.0, 5.0, 8), ("20 m / 20 deg", 20.0, 20.0, 25)]:
+            r = georef(sim, run, f"{base}/als_{int(shift)}", T_true, shift, turn, search, int(seed))
+            r.update({"scenario": scenario, "seed": seed, "start": start})
+            print(json.dumps(r), flush=True)
+            results.append(r)
+
+print("\n| scenario | start | runs ok | horizontal mean (max) m | height mean abs m | heading mean abs deg | within 1 sigma | within 2 sigma |")
+print("|---|---|---|---|---|---|---|---|")
+for scenario in scenarios:
+    for start in ["5 m / 5 deg", "20 m / 20 deg"]:
+        rows = [r for r in results if r["scenario"] == scenario and r["start"] == start]
+        ok = [r for r in rows if r["ok"]]
+        if not ok:
+            print(f"| {scenario} | {start} | 0 of {len(rows)} | | | | | |")
+            continue
+        h = [r["horizontal_mean_m"] for r in ok]
+        z = [abs(r["height_mean_m"]) for r in ok]
+        y = [abs(r["heading_mean_deg"]) for r in ok]
+        ratios = [abs(e) / s for r in ok for e, s in zip(r["transform_error"], r["sigma"]) if s > 0]
+        within1 = sum(x <= 1 for x in ratios) / len(ratios)
+        within2 = sum(x <= 2 for x in ratios) / len(ratios)
+        print(f"| {scenario} | {start} | {len(ok)} of {len(rows)} | {np.mean(h):.3f} ({max(h):.3f}) | "
+              f"{np.mean(z):.3f} | {np.mean(y):.3f} | {100 * within1:.0f} % | {100 * within2:.0f} % |")
