@@ -46,33 +46,34 @@ lie::SE3 offBy(const lie::SE3& T, const Eigen::Vector3d& shift_m, double yaw_deg
                   T.translation() + shift_m);
 }
 
-TEST(AlsRegistration, FromAGnssGuessTheMapIsPlacedToDecimetres) {
-  const Plot& p = plot();
-  for (const auto& [shift, yaw] : {std::pair{Eigen::Vector3d(4.0, -3.0, 2.5), 5.0},
-                                   std::pair{Eigen::Vector3d(-3.5, 3.5, -3.0), -4.0}}) {
-    const AlsRegistration r = registerToAls(p.map_world, p.als_grid, offBy(p.T_grid_world, shift, yaw));
-    ASSERT_TRUE(r.ok) << r.reason;
-    const lie::SE3 error = p.T_grid_world.inverse() * r.T_grid_map;
-    const Eigen::Vector3d t = p.T_grid_world.rotation() * error.translation();
-    EXPECT_LT(t.head<2>().norm(), 0.2) << t.transpose();
-    EXPECT_LT(std::abs(t.z()), 0.1) << t.transpose();
-    EXPECT_LT(std::abs(error.rotation().Log().z()) * kDegPerRad, 0.2);
-    EXPECT_GT(r.coverage, 0.5);
-    EXPECT_GT(r.sigma.head<3>().minCoeff(), 0.0);
-  }
+/// Within 10 cm horizontally, 5 cm in height and 0.1 deg in heading of the truth (the results
+/// are 1-2 cm and 0.02 deg: a broken step is metres off).
+void expectPlaced(const AlsRegistration& r, const lie::SE3& T_grid_map_true) {
+  ASSERT_TRUE(r.ok) << r.reason;
+  const lie::SE3 error = T_grid_map_true.inverse() * r.T_grid_map;
+  const Eigen::Vector3d t = T_grid_map_true.rotation() * error.translation();
+  EXPECT_LT(t.head<2>().norm(), 0.1) << t.transpose();
+  EXPECT_LT(std::abs(t.z()), 0.05) << t.transpose();
+  EXPECT_LT(std::abs(error.rotation().Log().z()) * kDegPerRad, 0.1);
+  EXPECT_GT(r.coverage, 0.5);
+  EXPECT_GT(r.sigma.head<3>().minCoeff(), 0.0);
 }
 
-TEST(AlsRegistration, WithoutGnssFromARoughPose20mAnd20degOff) {
+TEST(AlsRegistration, FromAGnssGuessTheMapIsPlacedToCentimetres) {
   const Plot& p = plot();
-  const AlsRegistration r =
-      registerToAls(p.map_world, p.als_grid, offBy(p.T_grid_world, {15.0, -12.0, 4.0}, 18.0),
-                    {.search_xy_m = 25.0, .search_yaw_deg = 25.0});
-  ASSERT_TRUE(r.ok) << r.reason;
-  const lie::SE3 error = p.T_grid_world.inverse() * r.T_grid_map;
-  const Eigen::Vector3d t = p.T_grid_world.rotation() * error.translation();
-  EXPECT_LT(t.head<2>().norm(), 0.2) << t.transpose();
-  EXPECT_LT(std::abs(t.z()), 0.1) << t.transpose();
-  EXPECT_LT(std::abs(error.rotation().Log().z()) * kDegPerRad, 0.2);
+  expectPlaced(registerToAls(p.map_world, p.als_grid, offBy(p.T_grid_world, {4.0, -3.0, 2.5}, 5.0)),
+               p.T_grid_world);
+  expectPlaced(
+      registerToAls(p.map_world, p.als_grid, offBy(p.T_grid_world, {-3.5, 3.5, -3.0}, -4.0)),
+      p.T_grid_world);
+}
+
+TEST(AlsRegistration, WithoutGnssFromARoughPose20mAnd18degOff) {
+  const Plot& p = plot();
+  expectPlaced(registerToAls(p.map_world, p.als_grid,
+                             offBy(p.T_grid_world, {15.0, -12.0, 4.0}, 18.0),
+                             {.search_xy_m = 25.0, .search_yaw_deg = 25.0}),
+               p.T_grid_world);
 }
 
 TEST(AlsRegistration, AnAlsTileThatDoesNotCoverTheMapIsRefused) {
