@@ -13,7 +13,7 @@ up, yaw) within 1 and 2 sigma.
 Usage: bench/als_georef.py OUT_DIR [SEEDS] [SCENARIOS]   (environment: TAIGA, DURATION, BEAMS)
 Example: bench/als_georef.py /tmp/als_bench "21 22 23" "handheld-loop harvester"
 """
-import json, math, os, subprocess, sys
+import json, math, os, subprocess, sys, time
 import numpy as np
 import yaml
 
@@ -60,9 +60,12 @@ def georef(sim, run, dest, T_true, shift_m, turn_deg, search, seed):
     cmd = [taiga, "georef", "--als", f"{sim}/als.las", "--run", run, "--guess",
            f"{e:.3f},{n:.3f},{yaw:.3f}", "--search-m", str(search), "--search-deg", str(search),
            "--out", dest]
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    start_s = time.monotonic()
+    subprocess.run(cmd, capture_output=True, text=True)
+    seconds = time.monotonic() - start_s
     report = yaml.safe_load(open(f"{dest}/georef_als.yaml"))
-    result = {"ok": report["ok"], "reason": report.get("reason", "")}
+    result = {"ok": report["ok"], "reason": report.get("reason", ""), "seconds": round(seconds, 1),
+              "map_points_used": report["map_points"], "als_points": report["als_points"]}
     if not report["ok"]:
         return result
     errors = json.loads(subprocess.run(["python3", "bench/georef_error.py", sim,
@@ -98,14 +101,14 @@ for scenario in scenarios:
             print(json.dumps(r), flush=True)
             results.append(r)
 
-print("\n| scenario | start | runs ok | horizontal mean (max) m | height mean abs m | heading mean abs deg | within 1 sigma | within 2 sigma |")
-print("|---|---|---|---|---|---|---|---|")
+print("\n| scenario | start | runs ok | horizontal mean (max) m | height mean abs m | heading mean abs deg | within 1 sigma | within 2 sigma | seconds (max) |")
+print("|---|---|---|---|---|---|---|---|---|")
 for scenario in scenarios:
     for start in ["5 m / 5 deg", "20 m / 20 deg"]:
         rows = [r for r in results if r["scenario"] == scenario and r["start"] == start]
         ok = [r for r in rows if r["ok"]]
         if not ok:
-            print(f"| {scenario} | {start} | 0 of {len(rows)} | | | | | |")
+            print(f"| {scenario} | {start} | 0 of {len(rows)} | | | | | | |")
             continue
         h = [r["horizontal_mean_m"] for r in ok]
         z = [abs(r["height_mean_m"]) for r in ok]
@@ -114,4 +117,5 @@ for scenario in scenarios:
         within1 = sum(x <= 1 for x in ratios) / len(ratios)
         within2 = sum(x <= 2 for x in ratios) / len(ratios)
         print(f"| {scenario} | {start} | {len(ok)} of {len(rows)} | {np.mean(h):.3f} ({max(h):.3f}) | "
-              f"{np.mean(z):.3f} | {np.mean(y):.3f} | {100 * within1:.0f} % | {100 * within2:.0f} % |")
+              f"{np.mean(z):.3f} | {np.mean(y):.3f} | {100 * within1:.0f} % | {100 * within2:.0f} % | "
+              f"{max(r.get('seconds', 0) for r in ok):.1f} |")
