@@ -153,6 +153,105 @@ AlsRegistration failed(AlsRegistration r, std::string reason) {
   return r;
 }
 
+/// Step 3's outcome.
+struct Search {
+  lie::SE3 T_local_map;  ///< the fine search's best pose
+  double score = 0.0;    ///< its score
+  double best_coarse_score = 0.0;
+  /// The best coarse candidate in another basin (the search's distinct candidates include the
+  /// best one's neighbours 2 m or 2 deg away), if any.
+  std::optional<registration::CorrelativeCandidate> alternative;
+  registration::Separation alternative_apart;
+};
+
+Search searchHeadingAndPosition(std::span<const Vec3> selected, std::span<const Vec3> als_local,
+                                const lie::SE3& T_local_map,
+                                const AlsRegistrationOptions& options) {
+  const registration::Occupancy coarse(als_local, 2.0);
+  const std::vector<registration::CorrelativeCandidate> candidates =
+      registration::correlativeSearch(selected, coarse, T_local_map,
+                                      {.yaw_half_deg = options.search_yaw_deg,
+                                       .yaw_step_deg = 1.0,
+                                       .xy_half_m = options.search_xy_m,
+                                       .xy_step_m = 1.0,
+                                       .voxel_m = 2.0,
+                                       .max_source = 3000},
+                                      12);
+  Search search;
+  if (candidates.empty()) return search;
+  const lie::SE3& best = candidates.front().T_target_source;
+  search.best_coarse_score = candidates.front().score;
+  for (const auto& c : candidates) {
+    logger().debug("ALS coarse candidate: {:.2f} m, {:.2f} deg from the start, score {:.3f}",
+                   (c.T_target_source.translation() - T_local_map.translation()).norm(),
+                   registration::separation(T_local_map, c.T_target_source).deg, c.score);
+    const registration::Separation apart = registration::separation(best, c.T_target_source);
+    if (!search.alternative && (apart.m > kOtherBasin_m || apart.deg > kOtherBasin_deg)) {
+      search.alternative = c;
+      search.alternative_apart = apart;
+    }
+  }
+  const registration::Occupancy fine(als_local, 1.0);
+  const registration::CorrelativeCandidate refined =
+      registration::correlativeSearch(selected, fine, best,
+                                      {.yaw_half_deg = 1.5,
+                                       .yaw_step_deg = 0.25,
+                                       .xy_half_m = 1.5,
+                                       .xy_step_m = 0.25,
+                                       .voxel_m = 1.0,
+                                       .max_source = 3000},
+                                      1)
+          .front();
+  search.T_local_map = refined.T_target_source;
+  search.score = refined.score;
+  return search;
+}
+
+/// Step 4: GICP from the search's pose, wide correspondences first (their cost is smoother, so
+/// starts a few decimetres and tenths of a degree apart settle in one place), then kNear_m.
+registration::RegistrationResult alignSixDof(std::span<const Vec3> source,
+                                             std::span<const Vec3> als_local, lie::SE3 T_local_map,
+                                             const registration::GicpConfig& gicp) {
+  registration::GicpConfig wide = gicp;
+  wide.max_correspondence_distance_m = 2.5 * kNear_m;
+  const registration::RegistrationResult settled =
+      registration::alignGicp(source, als_local, T_local_map, wide);
+  if (settled.converged) T_local_map = settled.T_target_source;
+  registration::RegistrationResult r =
+      registration::alignGicp(source, als_local, T_local_map, gicp);
+  if (!r.converged && r.reason.starts_with("no convergence")) {
+    // The correspondences within kNear_m can switch back and forth near the solution, and the
+    // steps never fall below GICP's 0.1 mm: a second run from where the first stopped that moves
+    // less than 2 cm and 0.02 deg says the pose is settled to that.
+    registration::RegistrationResult again =
+        registration::alignGicp(source, als_local, r.T_target_source, gicp);
+    const registration::Separation moved =
+        registration::separation(r.T_target_source, again.T_target_source);
+    if (moved.m < 0.02 && moved.deg < 0.02) {
+      again.converged = true;
+      again.reason.clear();
+    }
+    r = std::move(again);
+  }
+  logger().debug("ALS GICP: {} iterations, {:.3f} m and {:.3f} deg from the search, {}",
+                 r.iterations, (r.T_target_source.translation() - T_local_map.translation()).norm(),
+                 registration::separation(T_local_map, r.T_target_source).deg, r.reason);
+  return r;
+}
+
+/// Step 5's coverage: the share of `source` (placed by T) with an ALS point within kNear_m.
+double coverage(std::span<const Vec3> source, std::span<const Vec3> als_local,
+                const lie::SE3& T_local_map) {
+  const registration::KdTree als_tree(als_local);
+  std::size_t near = 0;
+  for (const Vec3& p : source) {
+    std::size_t index = 0;
+    double d2 = 0.0;
+    near += als_tree.nearestWithin(T_local_map * p, kNear_m, index, d2);
+  }
+  return static_cast<double>(near) / static_cast<double>(std::max<std::size_t>(source.size(), 1));
+}
+
 }  // namespace
 
 AlsRegistration registerToAls(std::span<const Vec3> map_points, std::span<const Vec3> als_points,
@@ -182,43 +281,14 @@ AlsRegistration registerToAls(std::span<const Vec3> map_points, std::span<const 
                   "the ALS does not cover the map: no 2 m cell in common at the guessed position");
   T_local_map = raised(T_local_map, *dz);
 
-  // Step 3: heading and position, coarse to fine.
-  const registration::Occupancy coarse(als_local, 2.0);
-  const std::vector<registration::CorrelativeCandidate> candidates =
-      registration::correlativeSearch(selected, coarse, T_local_map,
-                                      {.yaw_half_deg = options.search_yaw_deg,
-                                       .yaw_step_deg = 1.0,
-                                       .xy_half_m = options.search_xy_m,
-                                       .xy_step_m = 1.0,
-                                       .voxel_m = 2.0,
-                                       .max_source = 3000},
-                                      12);
-  if (candidates.empty()) return failed(result, "the correlative search found no candidate");
-  // The alternative: the best candidate in another basin (the search's distinct candidates
-  // include the best one's neighbours 2 m or 2 deg away).
-  const registration::CorrelativeCandidate* alternative = nullptr;
-  for (const auto& c : candidates) {
-    const registration::Separation apart =
-        registration::separation(candidates.front().T_target_source, c.T_target_source);
-    if (apart.m > kOtherBasin_m || apart.deg > kOtherBasin_deg) {
-      alternative = &c;
-      break;
-    }
-  }
-  for (const auto& c : candidates)
-    logger().debug("ALS coarse candidate: {:.2f} m, {:.2f} deg from the start, score {:.3f}",
-                   (c.T_target_source.translation() - T_local_map.translation()).norm(),
-                   registration::separation(T_local_map, c.T_target_source).deg, c.score);
-  const registration::Occupancy fine(als_local, 1.0);
-  const std::vector<registration::CorrelativeCandidate> refined = registration::correlativeSearch(
-      selected, fine, candidates.front().T_target_source,
-      {.yaw_half_deg = 1.5, .yaw_step_deg = 0.25, .xy_half_m = 1.5, .xy_step_m = 0.25,
-       .voxel_m = 1.0, .max_source = 3000},
-      1);
-  result.score = refined.front().score;
-  result.second_score =
-      alternative ? alternative->score / candidates.front().score * result.score : 0.0;
-  T_local_map = refined.front().T_target_source;
+  // Step 3: heading and position; the height again.
+  const Search search = searchHeadingAndPosition(selected, als_local, T_local_map, options);
+  if (search.best_coarse_score <= 0.0)
+    return failed(result, "the correlative search found no candidate");
+  result.score = search.score;
+  if (search.alternative)
+    result.second_score = search.alternative->score / search.best_coarse_score * search.score;
+  T_local_map = search.T_local_map;
   if (const auto again = heightShift(transformed(selected, T_local_map), als_local))
     T_local_map = raised(T_local_map, *again);
   result.height_shift_m = T_local_map.translation().z() + origin.z() - guess.translation().z();
@@ -228,59 +298,23 @@ AlsRegistration registerToAls(std::span<const Vec3> map_points, std::span<const 
   registration::GicpConfig gicp;
   gicp.max_correspondence_distance_m = kNear_m;
   gicp.max_iterations = 200;  // from a search 0.25 m / 0.25 deg apart: more steps than the odometry
-  // Wider correspondences first: their cost is smoother, so starts a few decimetres and tenths of
-  // a degree apart (the search's steps) settle in the same place; then the 1 m ones.
-  registration::GicpConfig wide = gicp;
-  wide.max_correspondence_distance_m = 2.5 * kNear_m;
-  const registration::RegistrationResult settled =
-      registration::alignGicp(source, als_local, T_local_map, wide);
-  if (settled.converged) T_local_map = settled.T_target_source;
-  registration::RegistrationResult r =
-      registration::alignGicp(source, als_local, T_local_map, gicp);
-  if (!r.converged && r.reason.starts_with("no convergence")) {
-    // The correspondences within kNear_m can switch back and forth near the solution, and the
-    // steps never fall below GICP's 0.1 mm: a second run from where the first stopped that moves
-    // less than 2 cm and 0.02 deg says the pose is settled to that.
-    registration::RegistrationResult again =
-        registration::alignGicp(source, als_local, r.T_target_source, gicp);
-    const registration::Separation moved = registration::separation(r.T_target_source,
-                                                                    again.T_target_source);
-    logger().debug("ALS GICP again: moved {:.3f} m, {:.3f} deg", moved.m, moved.deg);
-    if (moved.m < 0.02 && moved.deg < 0.02) {
-      again.converged = true;
-      again.reason.clear();
-    }
-    r = std::move(again);
-  }
-  logger().debug("ALS GICP: {} iterations, {:.3f} m and {:.3f} deg from the search, {}",
-                 r.iterations, (r.T_target_source.translation() - T_local_map.translation()).norm(),
-                 registration::separation(T_local_map, r.T_target_source).deg, r.reason);
+  const registration::RegistrationResult r = alignSixDof(source, als_local, T_local_map, gicp);
   if (!r.converged) return failed(result, "GICP to the ALS did not converge: " + r.reason);
   T_local_map = r.T_target_source;
-
-  // Step 5: checks.
-  const registration::KdTree als_tree(als_local);
-  std::size_t near = 0;
-  for (const Vec3& p : source) {
-    std::size_t index = 0;
-    double d2 = 0.0;
-    near += als_tree.nearestWithin(T_local_map * p, kNear_m, index, d2);
-  }
-  result.coverage = static_cast<double>(near) / static_cast<double>(source.size());
   result.T_grid_map = lie::SE3(T_local_map.rotation(), T_local_map.translation() + origin);
+
+  // Step 5: checks, then the 1-sigma.
+  result.coverage = coverage(source, als_local, T_local_map);
   if (result.coverage < options.min_coverage)
     return failed(result, fmt::format("the ALS covers {:.0f} % of the map's ground and crowns "
                                       "(at least {:.0f} % needed): another tile, or a wrong guess",
                                       100.0 * result.coverage, 100.0 * options.min_coverage));
-  if (alternative && alternative->score > options.max_second_score * candidates.front().score) {
-    const registration::Separation apart =
-        registration::separation(candidates.front().T_target_source, alternative->T_target_source);
-    return failed(result, fmt::format("ambiguous: a pose {:.1f} m / {:.1f} deg from the best scores "
-                                      "{:.3f} against {:.3f}",
-                                      apart.m, apart.deg, alternative->score,
-                                      candidates.front().score));
-  }
-
+  if (search.alternative &&
+      search.alternative->score > options.max_second_score * search.best_coarse_score)
+    return failed(result, fmt::format("ambiguous: a pose {:.1f} m / {:.1f} deg from the best "
+                                      "scores {:.3f} against {:.3f}",
+                                      search.alternative_apart.m, search.alternative_apart.deg,
+                                      search.alternative->score, search.best_coarse_score));
   result.sigma = jackknifeSigma(source, als_local, T_local_map, gicp);
   result.ok = true;
   return result;
