@@ -28,7 +28,8 @@ struct GeorefOptions {
 
 int runGeoref(const GeorefOptions& options) {
   if (!options.als.als.empty()) {
-    if (options.als.run.empty()) throw InputError("taiga georef --als: give the run: --run RUN_DIR");
+    if (options.als.run.empty())
+      throw InputError("taiga georef --als: give the run: --run RUN_DIR");
     AlsGeorefOptions als = options.als;
     als.out = options.out;
     als.epsg = options.epsg;
@@ -87,12 +88,14 @@ Command addGeorefCommand(CLI::App& tool) {
   parser->add_option("--guess", options->als.guess,
                      "With --als: the map origin's E,N and heading (deg from grid east), when the "
                      "run has no GNSS georeference (default: RUN/georef/georef.yaml)");
-  parser->add_option("--search-m", options->als.search_m,
-                     "With --als: half width of the position search, m (default 8 from GNSS, 25 "
-                     "from --guess)")
+  parser
+      ->add_option("--search-m", options->als.search_m,
+                   "With --als: half width of the position search, m (default 8 from GNSS, 25 "
+                   "from --guess)")
       ->check(CLI::PositiveNumber);
-  parser->add_option("--search-deg", options->als.search_deg,
-                     "With --als: half width of the heading search, deg (default 8 / 25)")
+  parser
+      ->add_option("--search-deg", options->als.search_deg,
+                   "With --als: half width of the heading search, deg (default 8 / 25)")
       ->check(CLI::Range(0.5, 180.0));
   parser->add_option("--method", options->method,
                      "Fitting method (default: georef.method of --config, robust)")

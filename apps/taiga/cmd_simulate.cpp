@@ -9,8 +9,8 @@
 #include "command.hpp"
 #include "taiga/core/errors.hpp"
 #include "taiga/core/progress.hpp"
-#include "taiga/sim/realism.hpp"
 #include "taiga/sim/als.hpp"
+#include "taiga/sim/realism.hpp"
 #include "taiga/sim/reference_cloud.hpp"
 #include "taiga/sim/scenario_yaml.hpp"
 #include "taiga/sim/simulator.hpp"
@@ -89,8 +89,7 @@ int runSimulate(const SimulateOptions& options) {
         "wrote {}: {} points of {} pulses over {:.2f} ha ({} last returns, {} ground; {:.0f} MB) "
         "in EPSG:{} in {:.1f} s\n",
         path.string(), als.points, als.pulses, als.area_m2 / 1e4, als.last_returns,
-        als.ground_points, static_cast<double>(als.file_bytes) / 1e6,
-        scenario.gnss.georef_epsg,
+        als.ground_points, static_cast<double>(als.file_bytes) / 1e6, scenario.gnss.georef_epsg,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_als).count());
   }
   return kExitOk;
@@ -164,10 +163,11 @@ Command addSimulateCommand(CLI::App& tool) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   parser
-      ->add_option("--als", options->als_pulses_per_m2,
-                   "Also write als.las: the plot as an airborne laser scanner records it (this many "
-                   "pulses per m^2, first and last returns, ground classified) in the projected "
-                   "CRS of georef_truth.yaml")
+      ->add_option(
+          "--als", options->als_pulses_per_m2,
+          "Also write als.las: the plot as an airborne laser scanner records it (this many "
+          "pulses per m^2, first and last returns, ground classified) in the projected "
+          "CRS of georef_truth.yaml")
       ->expected(0, 1)
       ->default_str("5")
       ->check(CLI::Range(0.1, 1000.0));

@@ -102,8 +102,8 @@ int runTrees(const TreesOptions& options) {
     // lidR's normalize_height or 3DFin work on).
     std::vector<float> above_ground_m(local.size());
     for (std::size_t i = 0; i < local.size(); ++i)
-      above_ground_m[i] = static_cast<float>(
-          local[i].z() - inventory.terrain.heightAt(local[i].x(), local[i].y()));
+      above_ground_m[i] =
+          static_cast<float>(local[i].z() - inventory.terrain.heightAt(local[i].x(), local[i].y()));
     io::LasWriter writer(out / "trees_map.las",
                          {.wkt = wkt,
                           .extra_float_name = "HeightAboveGround",

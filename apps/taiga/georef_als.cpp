@@ -53,9 +53,8 @@ Guess startingPose(const AlsGeorefOptions& options) {
       throw InputError(fmt::format("--guess: expected E,N,YAW_DEG, found '{}'", options.guess));
     // The height comes from the ALS (the registration's height step); the heading turns the
     // map's x axis from grid east, counterclockwise.
-    guess.T_grid_map =
-        lie::SE3(lie::SO3::Exp(Eigen::Vector3d(0.0, 0.0, values[2] * kRadPerDeg)),
-                 Eigen::Vector3d(values[0], values[1], 0.0));
+    guess.T_grid_map = lie::SE3(lie::SO3::Exp(Eigen::Vector3d(0.0, 0.0, values[2] * kRadPerDeg)),
+                                Eigen::Vector3d(values[0], values[1], 0.0));
     guess.search_m = guess.search_deg = 25.0;
     guess.source = "--guess";
   } else {
@@ -105,7 +104,8 @@ std::vector<Eigen::Vector3d> readAls(const std::vector<fs::path>& files,
   std::vector<Eigen::Vector3d> points;
   for (const fs::path& file : files) {
     io::LasReader reader(file);
-    const Eigen::AlignedBox2d tile(reader.header().min_m.head<2>(), reader.header().max_m.head<2>());
+    const Eigen::AlignedBox2d tile(reader.header().min_m.head<2>(),
+                                   reader.header().max_m.head<2>());
     if (!tile.intersects(area)) continue;
     used.push_back(file.string());
     for (std::uint64_t first = 0; first < reader.pointCount(); first += 1u << 20) {
@@ -121,30 +121,33 @@ std::vector<Eigen::Vector3d> readAls(const std::vector<fs::path>& files,
 void writeReport(const fs::path& path, const georef::AlsRegistration& r, const Guess& guess,
                  double scale, const std::vector<std::string>& tiles) {
   auto out = fmt::output_file(path.string());
-  out.print("# taiga georef --als: the run's map registered to airborne lidar "
-            "(docs/georeferencing.md, ALS)\n");
+  out.print(
+      "# taiga georef --als: the run's map registered to airborne lidar "
+      "(docs/georeferencing.md, ALS)\n");
   out.print("ok: {}\n", r.ok ? "true" : "false");
   if (!r.ok) out.print("reason: \"{}\"\n", r.reason);
   out.print("epsg: {}\nstart: \"{}\"\nsearch_m: {}\nsearch_deg: {}\n", guess.epsg, guess.source,
             guess.search_m, guess.search_deg);
   out.print("als_tiles:\n");
   for (const std::string& t : tiles) out.print("  - \"{}\"\n", t);
-  out.print("map_points: {}\nals_points: {}\ncoverage: {:.4f}\nscore: {:.4f}\nsecond_score: {:.4f}\n",
-            r.map_points, r.als_points, r.coverage, r.score, r.second_score);
+  out.print(
+      "map_points: {}\nals_points: {}\ncoverage: {:.4f}\nscore: {:.4f}\nsecond_score: {:.4f}\n",
+      r.map_points, r.als_points, r.coverage, r.score, r.second_score);
   out.print("height_shift_m: {:.4f}\ngrid_scale: {:.8f}\n", r.height_shift_m, scale);
   if (!r.ok) return;
-  out.print("# [E, N, h, 1] = T_epsg_world * [x, y, z, 1] (the map frame is the run's world;\n"
-            "# grid_scale horizontally, heights unscaled)\n");
+  out.print(
+      "# [E, N, h, 1] = T_epsg_world * [x, y, z, 1] (the map frame is the run's world;\n"
+      "# grid_scale horizontally, heights unscaled)\n");
   out.print("T_epsg_world:\n");
   const Eigen::Matrix4d T =
       r.T_grid_map.matrix() * Eigen::Vector4d(scale, scale, 1.0, 1.0).asDiagonal();
   for (int i = 0; i < 4; ++i)
     out.print("  - [{}, {}, {}, {}]\n", T(i, 0), T(i, 1), T(i, 2), T(i, 3));
-  out.print("# 1-sigma (jackknife over the map's quadrants): east, north, up (m); roll, pitch, "
-            "yaw (deg)\n");
+  out.print(
+      "# 1-sigma (jackknife over the map's quadrants): east, north, up (m); roll, pitch, "
+      "yaw (deg)\n");
   out.print("sigma: [{:.4f}, {:.4f}, {:.4f}, {:.4f}, {:.4f}, {:.4f}]\n", r.sigma[0], r.sigma[1],
-            r.sigma[2], r.sigma[3] * kDegPerRad, r.sigma[4] * kDegPerRad,
-            r.sigma[5] * kDegPerRad);
+            r.sigma[2], r.sigma[3] * kDegPerRad, r.sigma[4] * kDegPerRad, r.sigma[5] * kDegPerRad);
 }
 
 }  // namespace
@@ -152,8 +155,8 @@ void writeReport(const fs::path& path, const georef::AlsRegistration& r, const G
 int runAlsGeoref(const AlsGeorefOptions& options) {
   const fs::path run = options.run;
   if (!fs::exists(run / "map.las") || !fs::exists(run / "trajectory.tum"))
-    throw InputError(fmt::format("{}: expected a run directory with map.las and trajectory.tum",
-                                 run.string()));
+    throw InputError(
+        fmt::format("{}: expected a run directory with map.las and trajectory.tum", run.string()));
   const Guess guess = startingPose(options);
   const geo::CoordinateConverter converter(guess.epsg);
   // Grid metres per map metre where the map lies (the projection's scale and the height
@@ -163,7 +166,8 @@ int runAlsGeoref(const AlsGeorefOptions& options) {
   const double scale = converter.gridTangent(converter.fromProjected(start)).scale;
   const Eigen::DiagonalMatrix<double, 3> S(scale, scale, 1.0);
   std::vector<Eigen::Vector3d> map_points = io::readAnyCloudFile(run / "map.las").positions;
-  if (map_points.empty()) throw InputError(fmt::format("{}: no points", (run / "map.las").string()));
+  if (map_points.empty())
+    throw InputError(fmt::format("{}: no points", (run / "map.las").string()));
   for (Eigen::Vector3d& p : map_points) p = S * p;
 
   // The ALS around the map where the guess puts it, wide enough for the search.
@@ -182,14 +186,15 @@ int runAlsGeoref(const AlsGeorefOptions& options) {
         files.size(), area.min().x(), area.max().x(), area.min().y(), area.max().y(), guess.epsg,
         guess.source));
 
-  const georef::AlsRegistration r = georef::registerToAls(
-      map_points, als, guess.T_grid_map,
-      {.search_xy_m = guess.search_m, .search_yaw_deg = guess.search_deg});
+  const georef::AlsRegistration r =
+      georef::registerToAls(map_points, als, guess.T_grid_map,
+                            {.search_xy_m = guess.search_m, .search_yaw_deg = guess.search_deg});
   fs::create_directories(options.out);
   writeReport(fs::path(options.out) / "georef_als.yaml", r, guess, scale, tiles);
-  fmt::print("als        {} points from {} of {} tiles near the map; {} map points (ground and "
-             "crowns)\n",
-             als.size(), tiles.size(), files.size(), r.map_points);
+  fmt::print(
+      "als        {} points from {} of {} tiles near the map; {} map points (ground and "
+      "crowns)\n",
+      als.size(), tiles.size(), files.size(), r.map_points);
   if (!r.ok) {
     fmt::print(stderr, "taiga georef: the map was not registered to the ALS: {}\n", r.reason);
     return kExitFailure;
@@ -203,10 +208,11 @@ int runAlsGeoref(const AlsGeorefOptions& options) {
       "horizontally, {:.2f} m in height and turned {:.2f} deg from the start ({})\n",
       100.0 * r.coverage, r.score, r.second_score, moved.head<2>().norm(), moved.z(), turned_deg,
       guess.source);
-  fmt::print("1-sigma    east {:.3f} m, north {:.3f} m, up {:.3f} m, roll {:.3f} deg, pitch {:.3f} "
-             "deg, yaw {:.3f} deg\n",
-             r.sigma[0], r.sigma[1], r.sigma[2], r.sigma[3] * kDegPerRad,
-             r.sigma[4] * kDegPerRad, r.sigma[5] * kDegPerRad);
+  fmt::print(
+      "1-sigma    east {:.3f} m, north {:.3f} m, up {:.3f} m, roll {:.3f} deg, pitch {:.3f} "
+      "deg, yaw {:.3f} deg\n",
+      r.sigma[0], r.sigma[1], r.sigma[2], r.sigma[3] * kDegPerRad, r.sigma[4] * kDegPerRad,
+      r.sigma[5] * kDegPerRad);
 
   // The trajectory and the map in the grid.
   const Trajectory trajectory = io::readTum(run / "trajectory.tum");
@@ -224,9 +230,10 @@ int runAlsGeoref(const AlsGeorefOptions& options) {
   io::LasWriter writer(out / fmt::format("map_epsg{}.las", guess.epsg), {.wkt = converter.wkt()});
   writer.append(map);
   writer.close();
-  fmt::print("outputs    {}/ (georef_als.yaml, trajectory_epsg{}.csv, trajectory.geojson, "
-             "map_epsg{}.las)\n",
-             options.out, guess.epsg, guess.epsg);
+  fmt::print(
+      "outputs    {}/ (georef_als.yaml, trajectory_epsg{}.csv, trajectory.geojson, "
+      "map_epsg{}.las)\n",
+      options.out, guess.epsg, guess.epsg);
   return kExitOk;
 }
 

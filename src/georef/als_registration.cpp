@@ -20,12 +20,12 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-constexpr double kThin_m = 0.3;          ///< the map is thinned to one point per voxel this size
-constexpr double kGroundCell_m = 1.0;    ///< the map's lowest point per cell: its ground
-constexpr double kGroundBand_m = 0.3;    ///< ground: within this of the cell's lowest point
-constexpr double kCrownAbove_m = 3.0;    ///< crowns: more than this above it
-constexpr double kHeightCell_m = 2.0;    ///< cells of the height step
-constexpr double kNear_m = 1.0;          ///< coverage: an ALS point within this
+constexpr double kThin_m = 0.3;        ///< the map is thinned to one point per voxel this size
+constexpr double kGroundCell_m = 1.0;  ///< the map's lowest point per cell: its ground
+constexpr double kGroundBand_m = 0.3;  ///< ground: within this of the cell's lowest point
+constexpr double kCrownAbove_m = 3.0;  ///< crowns: more than this above it
+constexpr double kHeightCell_m = 2.0;  ///< cells of the height step
+constexpr double kNear_m = 1.0;        ///< coverage: an ALS point within this
 constexpr std::size_t kMaxGicpSource = 100000;
 /// A search candidate farther than this from the best is in another basin (an alternative).
 constexpr double kOtherBasin_m = 4.0, kOtherBasin_deg = 4.0;
@@ -75,7 +75,8 @@ std::vector<Vec3> groundAndCrowns(std::span<const Vec3> map_points) {
 
 /// Step 2: how much higher the ALS's lowest points lie than the map's, the median over the cells
 /// both have; none without a common cell.
-std::optional<double> heightShift(std::span<const Vec3> map_local, std::span<const Vec3> als_local) {
+std::optional<double> heightShift(std::span<const Vec3> map_local,
+                                  std::span<const Vec3> als_local) {
   const auto map_lowest = lowestPerCell(map_local, kHeightCell_m);
   const auto als_lowest = lowestPerCell(als_local, kHeightCell_m);
   std::vector<double> differences;
@@ -132,7 +133,8 @@ Eigen::Matrix<double, 6, 1> jackknifeSigma(std::span<const Vec3> source,
     std::vector<Vec3> kept;
     for (const Vec3& p : source)
       if ((p.x() >= x_mid ? 1 : 0) + (p.y() >= y_mid ? 2 : 0) != left_out) kept.push_back(p);
-    const registration::RegistrationResult r = registration::alignGicp(kept, als_local, solution, gicp);
+    const registration::RegistrationResult r =
+        registration::alignGicp(kept, als_local, solution, gicp);
     // The deviation in the grid's axes: translation, and the rotation vector R theta.
     const lie::Vector6 d = r.T_target_source.minus(solution);
     lie::Vector6 grid;
@@ -268,8 +270,9 @@ AlsRegistration registerToAls(std::span<const Vec3> map_points, std::span<const 
   const std::vector<Vec3> selected = groundAndCrowns(map_points);
   result.map_points = selected.size();
   if (selected.size() < 500)
-    return failed(result, fmt::format("the map has {} ground and crown points (at least 500 needed)",
-                                      selected.size()));
+    return failed(result,
+                  fmt::format("the map has {} ground and crown points (at least 500 needed)",
+                              selected.size()));
   if (als_local.size() < 500)
     return failed(result, fmt::format("{} ALS points (at least 500 needed)", als_local.size()));
 

@@ -20,9 +20,9 @@ constexpr std::uint16_t kHeaderSize = 375;  // LAS 1.4 public header block
 constexpr std::uint16_t kVlrHeaderSize = 54;
 constexpr std::uint8_t kPointFormat = 6;
 constexpr std::uint16_t kPointRecordSize = 30;  // format 6
-constexpr std::uint16_t kExtraBytesRecordId = 4;   // LASF_Spec: Extra Bytes
+constexpr std::uint16_t kExtraBytesRecordId = 4;  // LASF_Spec: Extra Bytes
 constexpr std::uint16_t kExtraBytesEntrySize = 192;
-constexpr std::uint8_t kExtraFloatType = 9;  // float32
+constexpr std::uint8_t kExtraFloatType = 9;     // float32
 constexpr std::uint16_t kWktRecordId = 2112;    // LASF_Projection: OGC coordinate system WKT
 constexpr std::uint16_t kGlobalEncodingWkt = 1 << 4;
 

@@ -25,7 +25,8 @@ void validate(const AlsParams& p) {
   const auto fail = [](const std::string& what) { throw InputError("ALS: " + what); };
   if (!(p.pulses_per_m2 > 0.0 && p.pulses_per_m2 <= 1000.0))
     fail(fmt::format("pulses_per_m2: expected 0 .. 1000, found {}", p.pulses_per_m2));
-  if (!(p.altitude_m >= 50.0)) fail(fmt::format("altitude_m: expected >= 50, found {}", p.altitude_m));
+  if (!(p.altitude_m >= 50.0))
+    fail(fmt::format("altitude_m: expected >= 50, found {}", p.altitude_m));
   if (!(p.half_swath_deg >= 0.0 && p.half_swath_deg < 60.0))
     fail(fmt::format("half_swath_deg: expected 0 .. 60, found {}", p.half_swath_deg));
   if (!(p.footprint_radius_m >= 0.0)) fail("footprint_radius_m: expected >= 0");
@@ -48,10 +49,12 @@ struct Pulse {
 
 Pulse castPulse(const Scene& scene, const Eigen::Vector3d& target_world, double z_flight_m,
                 const AlsParams& p, std::uint64_t seed, std::uint64_t index) {
-  const double off_nadir = (2.0 * hashUniform(seed, index, 2) - 1.0) * p.half_swath_deg * kRadPerDeg;
+  const double off_nadir =
+      (2.0 * hashUniform(seed, index, 2) - 1.0) * p.half_swath_deg * kRadPerDeg;
   // Flight lines along world y: the aircraft is displaced across track (x) from the target.
-  const Eigen::Vector3d air(target_world.x() + (z_flight_m - target_world.z()) * std::tan(off_nadir),
-                            target_world.y(), z_flight_m);
+  const Eigen::Vector3d air(
+      target_world.x() + (z_flight_m - target_world.z()) * std::tan(off_nadir), target_world.y(),
+      z_flight_m);
   const Eigen::Vector3d beam = (target_world - air).normalized();
   const Eigen::Vector3d e1 = beam.unitOrthogonal(), e2 = beam.cross(e1);
   const double t_max_m = 2.0 * (air - target_world).norm();
@@ -64,7 +67,8 @@ Pulse castPulse(const Scene& scene, const Eigen::Vector3d& target_world, double 
   std::optional<Hit> nearest, farthest;
   for (int k = 0; k < p.rays_per_pulse; ++k) {
     // Uniform over the footprint's disc (the first ray at its centre).
-    const double r = k == 0 ? 0.0 : p.footprint_radius_m * std::sqrt(hashUniform(seed, index, 3, k));
+    const double r =
+        k == 0 ? 0.0 : p.footprint_radius_m * std::sqrt(hashUniform(seed, index, 3, k));
     const double phi = 2.0 * std::numbers::pi * hashUniform(seed, index, 4, k);
     const Eigen::Vector3d aim = target_world + r * (std::cos(phi) * e1 + std::sin(phi) * e2);
     const Eigen::Vector3d direction = (aim - air).normalized();
@@ -94,8 +98,8 @@ Pulse castPulse(const Scene& scene, const Eigen::Vector3d& target_world, double 
 
 }  // namespace
 
-AlsReturns simulateAls(const Scene& scene, const Eigen::Vector2d& center_world,
-                       double half_size_m, const AlsParams& params, std::uint64_t seed) {
+AlsReturns simulateAls(const Scene& scene, const Eigen::Vector2d& center_world, double half_size_m,
+                       const AlsParams& params, std::uint64_t seed) {
   validate(params);
   if (!(half_size_m > 0.0)) throw InputError("ALS: the area's half size must be positive");
   const double area_m2 = 4.0 * half_size_m * half_size_m;
@@ -106,17 +110,16 @@ AlsReturns simulateAls(const Scene& scene, const Eigen::Vector2d& center_world,
       terrain.smoothHeight(center_world.x(), center_world.y()) + params.altitude_m;
 
   std::vector<Pulse> pulses(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                        const double x = center_world.x() +
-                                         (2.0 * hashUniform(stream, i, 0) - 1.0) * half_size_m;
-                        const double y = center_world.y() +
-                                         (2.0 * hashUniform(stream, i, 1) - 1.0) * half_size_m;
-                        const Eigen::Vector3d target(x, y, terrain.smoothHeight(x, y));
-                        pulses[i] = castPulse(scene, target, z_flight_m, params, stream, i);
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, 4096),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+          const double x = center_world.x() + (2.0 * hashUniform(stream, i, 0) - 1.0) * half_size_m;
+          const double y = center_world.y() + (2.0 * hashUniform(stream, i, 1) - 1.0) * half_size_m;
+          const Eigen::Vector3d target(x, y, terrain.smoothHeight(x, y));
+          pulses[i] = castPulse(scene, target, z_flight_m, params, stream, i);
+        }
+      });
 
   AlsReturns out;
   out.pulses = n;
@@ -138,8 +141,8 @@ AlsReturns simulateAls(const Scene& scene, const Eigen::Vector2d& center_world,
 AlsSummary writeAls(const Simulation& simulation, const std::filesystem::path& path,
                     const AlsParams& params) {
   const SceneLayout& layout = simulation.scene().layout();
-  AlsReturns als = simulateAls(simulation.scene(), layout.center_world, layout.half_size_m,
-                               params, simulation.seed());
+  AlsReturns als = simulateAls(simulation.scene(), layout.center_world, layout.half_size_m, params,
+                               simulation.seed());
   const GeorefTruth truth = georefTruth(simulation.scenario().gnss);
   for (Eigen::Vector3d& p : als.cloud.positions)
     p = (truth.T_epsg_world * p.homogeneous()).head<3>();

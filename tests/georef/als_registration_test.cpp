@@ -15,9 +15,9 @@ namespace taiga::georef {
 namespace {
 
 struct Plot {
-  std::vector<Eigen::Vector3d> map_world;   ///< the ground scanner's points, world frame
-  std::vector<Eigen::Vector3d> als_grid;    ///< the airborne survey, in the grid
-  lie::SE3 T_grid_world;                    ///< the truth
+  std::vector<Eigen::Vector3d> map_world;  ///< the ground scanner's points, world frame
+  std::vector<Eigen::Vector3d> als_grid;   ///< the airborne survey, in the grid
+  lie::SE3 T_grid_world;                   ///< the truth
 };
 
 const Plot& plot() {
@@ -27,15 +27,16 @@ const Plot& plot() {
     tls.angular_step_deg = 0.3;
     tls.voxel_m = 0.1;
     Plot out;
-    out.map_world = sim::simulateReferenceCloud(
-                        simulation.scene(), sim::referenceStations(simulation, tls), tls)
+    out.map_world = sim::simulateReferenceCloud(simulation.scene(),
+                                                sim::referenceStations(simulation, tls), tls)
                         .positions;
     const sim::SceneLayout& layout = simulation.scene().layout();
     const sim::AlsReturns als =
         sim::simulateAls(simulation.scene(), layout.center_world, layout.half_size_m, {}, 5);
     out.T_grid_world = lie::SE3(lie::SO3::Exp(Eigen::Vector3d(0.0, 0.0, 0.4)),
                                 Eigen::Vector3d(385120.0, 6672340.0, 95.0));
-    for (const Eigen::Vector3d& q : als.cloud.positions) out.als_grid.push_back(out.T_grid_world * q);
+    for (const Eigen::Vector3d& q : als.cloud.positions)
+      out.als_grid.push_back(out.T_grid_world * q);
     return out;
   }();
   return p;
@@ -70,16 +71,17 @@ TEST(AlsRegistration, FromAGnssGuessTheMapIsPlacedToCentimetres) {
 
 TEST(AlsRegistration, WithoutGnssFromARoughPose20mAnd18degOff) {
   const Plot& p = plot();
-  expectPlaced(registerToAls(p.map_world, p.als_grid,
-                             offBy(p.T_grid_world, {15.0, -12.0, 4.0}, 18.0),
-                             {.search_xy_m = 25.0, .search_yaw_deg = 25.0}),
-               p.T_grid_world);
+  expectPlaced(
+      registerToAls(p.map_world, p.als_grid, offBy(p.T_grid_world, {15.0, -12.0, 4.0}, 18.0),
+                    {.search_xy_m = 25.0, .search_yaw_deg = 25.0}),
+      p.T_grid_world);
 }
 
 TEST(AlsRegistration, AnAlsTileThatDoesNotCoverTheMapIsRefused) {
   const Plot& p = plot();
   std::vector<Eigen::Vector3d> elsewhere;
-  for (const Eigen::Vector3d& q : p.als_grid) elsewhere.push_back(q + Eigen::Vector3d(500.0, 0.0, 0.0));
+  for (const Eigen::Vector3d& q : p.als_grid)
+    elsewhere.push_back(q + Eigen::Vector3d(500.0, 0.0, 0.0));
   const AlsRegistration r = registerToAls(p.map_world, elsewhere, p.T_grid_world);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.reason.find("does not cover"), std::string::npos) << r.reason;

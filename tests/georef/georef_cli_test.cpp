@@ -432,7 +432,8 @@ TEST(GeorefCli, AlsPlacesTheRunsMapToDecimetresFromGnssAndFromARoughPose) {
   test::TempDir dir;
   const auto sim = dir.file("sim");
   ASSERT_EQ(runTaiga("simulate --scenario handheld-loop --duration 30 --beams 32 --columns 512 "
-                     "--seed 6 --als --out " + sim.string())
+                     "--seed 6 --als --out " +
+                     sim.string())
                 .exit_code,
             0);
   const auto run = dir.file("run");

@@ -77,8 +77,8 @@ TEST(Als, GroundReturnsLieOnTheTerrainAndTheCanopyAboveIt) {
 TEST(Als, TheSameCloudOnOneThreadAsOnMany) {
   AlsReturns one;
   tbb::task_arena(1).execute([&] {
-    one = simulateAls(simulation().scene(), simulation().scene().layout().center_world, 15.0, {},
-                      3);
+    one =
+        simulateAls(simulation().scene(), simulation().scene().layout().center_world, 15.0, {}, 3);
   });
   EXPECT_EQ(one.cloud.positions, survey().cloud.positions);
   EXPECT_EQ(one.returns, survey().returns);

@@ -17,8 +17,8 @@
 //    points' errors are correlated over metres, so the GICP Hessian's formal covariance would be
 //    ten times too small).
 // 5. Checks: the share of the map's points with an ALS point within 1 m (coverage), and the best
-//    candidate more than 4 m or 4 deg from the best one against it (ambiguity). A map the ALS does not cover, or
-//    an ambiguous search, is a failure with its reason, never a pose.
+//    candidate more than 4 m or 4 deg from the best one against it (ambiguity). A map the ALS does
+//    not cover, or an ambiguous search, is a failure with its reason, never a pose.
 
 #include <Eigen/Core>
 #include <span>
@@ -41,9 +41,9 @@ struct AlsRegistration {
   lie::SE3 T_grid_map;  ///< the map in the grid (easting, northing, height), when ok
   /// 1-sigma: east, north, up (m), roll, pitch, yaw (rad) in the grid.
   Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();
-  double coverage = 0.0;      ///< share of the map's points within 1 m of an ALS point
-  double score = 0.0;         ///< the fine search's best score (share of points in ALS voxels)
-  double second_score = 0.0;  ///< the best candidate's in another basin (4 m or 4 deg away)
+  double coverage = 0.0;        ///< share of the map's points within 1 m of an ALS point
+  double score = 0.0;           ///< the fine search's best score (share of points in ALS voxels)
+  double second_score = 0.0;    ///< the best candidate's in another basin (4 m or 4 deg away)
   double height_shift_m = 0.0;  ///< step 2's correction of the guess's height
   std::size_t map_points = 0;   ///< used (ground and crowns, thinned)
   std::size_t als_points = 0;

@@ -43,21 +43,21 @@ struct AlsParams {
 
 /// Returns of the pulses, world frame.
 struct AlsReturns {
-  PointCloud cloud;                                 ///< positions and intensities
-  std::vector<std::uint8_t> classifications;        ///< 2 ground, 1 other
+  PointCloud cloud;                                  ///< positions and intensities
+  std::vector<std::uint8_t> classifications;         ///< 2 ground, 1 other
   std::vector<std::array<std::uint8_t, 2>> returns;  ///< return number, number of returns
   std::size_t pulses = 0;
 };
 
 /// The returns of pulses over the square [center - half_size, center + half_size]^2 (world x, y).
 /// InputError for invalid params.
-AlsReturns simulateAls(const Scene& scene, const Eigen::Vector2d& center_world,
-                       double half_size_m, const AlsParams& params, std::uint64_t seed);
+AlsReturns simulateAls(const Scene& scene, const Eigen::Vector2d& center_world, double half_size_m,
+                       const AlsParams& params, std::uint64_t seed);
 
 struct AlsSummary {
   std::size_t pulses = 0;
   std::size_t points = 0;
-  std::size_t last_returns = 0;    ///< second returns of two-return pulses
+  std::size_t last_returns = 0;  ///< second returns of two-return pulses
   std::size_t ground_points = 0;
   double area_m2 = 0.0;
   std::uintmax_t file_bytes = 0;
