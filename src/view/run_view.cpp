@@ -69,9 +69,11 @@ json loopsJson(const fs::path& loops_csv, const Trajectory& keyframes,
   return out;
 }
 
+json noScans() { return {{"t_s", json::array()}, {"ms", json::array()}, {"status", json::array()}}; }
+
 /// Per scan: time, total processing time (timing.csv) and status (scans.csv).
 json scansJson(const fs::path& dir) {
-  json out = {{"t_s", json::array()}, {"ms", json::array()}, {"status", json::array()}};
+  json out = noScans();
   if (!fs::exists(dir / "timing.csv")) return out;
   const eval::TimingTable timing = eval::readTimingCsv(dir / "timing.csv");
   std::vector<eval::ScanStatusAt> statuses;
@@ -110,6 +112,8 @@ json summaryJson(const fs::path& path) {
   return out;
 }
 
+/// A cloud file has no side files: they are read from a run directory only (never from the
+/// working directory).
 json infoJson(const fs::path& input, bool run_dir, const LodTree& tree) {
   const Eigen::Vector3d& origin = tree.origin();
   json info = {{"mode", "run"},
@@ -119,10 +123,11 @@ json infoJson(const fs::path& input, bool run_dir, const LodTree& tree) {
                {"trajectory", json::array()},
                {"keyframes", json::array()},
                {"loops", json::array()},
-               {"scans", scansJson(run_dir ? input : fs::path())},
+               {"scans", noScans()},
                {"trees", json::array()},
                {"summary", json::object()}};
   if (!run_dir) return info;
+  info["scans"] = scansJson(input);
   info["trajectory"] = trajectoryJson(input / "trajectory.tum", origin);
   info["trees"] = treesJson(input / "trees.csv", origin);
   if (fs::exists(input / "keyframes.tum")) {

@@ -127,6 +127,8 @@ TEST(RunView, ACloudFileAloneIsShownWithoutAWalk) {
   EXPECT_EQ(info["name"], "map.las");
   EXPECT_EQ(info["points"], 30000);
   EXPECT_TRUE(info["trajectory"].empty());
+  EXPECT_TRUE(info["scans"]["ms"].empty());  // side files come from run directories only
+  EXPECT_TRUE(info["trees"].empty());
 }
 
 TEST(RunView, WhatCannotBeShownIsNamed) {
