@@ -10,7 +10,8 @@ Prints one JSON line per run and a Markdown table: mean errors of the grid traje
 height, heading), and how often the reported 1-sigma covered the transform's error (east, north,
 up, yaw) within 1 and 2 sigma.
 
-Usage: bench/als_georef.py OUT_DIR [SEEDS] [SCENARIOS]   (environment: TAIGA, DURATION, BEAMS)
+Usage: bench/als_georef.py OUT_DIR [SEEDS] [SCENARIOS]   (environment: TAIGA, DURATION, BEAMS,
+REALISM: ideal (default), typical or harsh)
 Example: bench/als_georef.py /tmp/als_bench "21 22 23" "handheld-loop harvester"
 """
 import json, math, os, subprocess, sys, time
@@ -20,6 +21,7 @@ import yaml
 taiga = os.environ.get("TAIGA", "build/bin/taiga")
 duration = os.environ.get("DURATION", "60")
 beams = os.environ.get("BEAMS", "32")
+realism = os.environ.get("REALISM", "ideal")
 out = sys.argv[1]
 seeds = (sys.argv[2] if len(sys.argv) > 2 else "21 22 23").split()
 scenarios = (sys.argv[3] if len(sys.argv) > 3 else "handheld-loop harvester").split()
@@ -39,9 +41,12 @@ def true_grid_pose(sim, run):
     """T_grid_map of the run's map frame: the truth's T_epsg_world times T_world_map (Kabsch)."""
     truth = yaml.safe_load(open(f"{sim}/georef_truth.yaml"))
     T_gw = np.array(truth["T_epsg_world"])
-    gt, _ = tum(f"{sim}/groundtruth.tum")
-    est, _ = tum(f"{run}/trajectory.tum")
-    pairs = [(est[t], gt[t]) for t in est if t in gt]
+    _, gt_rows = tum(f"{sim}/groundtruth.tum")
+    _, est_rows = tum(f"{run}/trajectory.tum")
+    gt_t = np.array([r[0] for r in gt_rows]); gt_p = np.array([r[1:4] for r in gt_rows])
+    # The truth's positions interpolated at the run's times (which need not fall on its samples).
+    pairs = [(np.array(r[1:4]), np.array([np.interp(r[0], gt_t, gt_p[:, k]) for k in range(3)]))
+             for r in est_rows if gt_t[0] <= r[0] <= gt_t[-1]]
     A = np.array([p[0] for p in pairs]); B = np.array([p[1] for p in pairs])
     ca, cb = A.mean(0), B.mean(0)
     U, _, Vt = np.linalg.svd((A - ca).T @ (B - cb))
@@ -89,7 +94,8 @@ for scenario in scenarios:
         sim, run = f"{base}/sim", f"{base}/run"
         if not os.path.exists(f"{sim}/als.las"):
             subprocess.run([taiga, "simulate", "--scenario", scenario, "--duration", duration,
-                            "--beams", beams, "--seed", seed, "--als", "--out", sim],
+                            "--beams", beams, "--seed", seed, "--realism", realism, "--als",
+                            "--out", sim],
                            check=True, capture_output=True)
         if not os.path.exists(f"{run}/map.las"):
             subprocess.run([taiga, "run", f"{sim}/recording.bag", "--config", f"{sim}/rig.yaml",

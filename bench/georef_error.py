@@ -2,7 +2,7 @@
 """Error of a georeferenced trajectory against the simulator's truth: each pose of
 trajectory_epsgNNNN.csv (`taiga georef`, `taiga georef --als`, or RUN/georef/) against the true
 body pose in the grid (SIM/groundtruth.tum through SIM/georef_truth.yaml's T_epsg_world), matched
-by time. Prints JSON: mean and max horizontal error, mean height error, mean heading error (deg).
+by time (the truth interpolated). Prints JSON: mean and max horizontal error, mean height error, mean heading error (deg).
 The run's own odometry error is included (centimetres).
 Usage: bench/georef_error.py SIM_DIR TRAJECTORY_EPSG.csv"""
 import bisect, csv, json, math, sys
@@ -26,10 +26,15 @@ def grid_pose(r):
 horizontal, height, heading = [], [], []
 for r in csv.DictReader(open(estimate)):
     t = float(r["t_s"])
+    # The truth linearly between its samples (200 Hz): a run's times need not fall on them.
     i = bisect.bisect_left(times, t)
-    if i >= len(times) or abs(times[i] - t) > 0.003:
+    if i == 0 or i >= len(times):
         continue
-    e, n, h, yaw = grid_pose(rows[i])
+    a, b = grid_pose(rows[i - 1]), grid_pose(rows[i])
+    f = (t - times[i - 1]) / (times[i] - times[i - 1])
+    dyaw = math.atan2(math.sin(b[3] - a[3]), math.cos(b[3] - a[3]))
+    e, n, h, yaw = (a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]),
+                    a[3] + f * dyaw)
     horizontal.append(math.hypot(float(r["easting_m"]) - e, float(r["northing_m"]) - n))
     height.append(float(r["height_m"]) - h)
     d = math.radians(float(r["yaw_grid_deg"])) - yaw
