@@ -64,6 +64,24 @@ int runGeoref(const GeorefOptions& options) {
       "deg, yaw {:.3f} deg\n",
       result.sigma[0], result.sigma[1], result.sigma[2], result.sigma[3] * kDegPerRad,
       result.sigma[4] * kDegPerRad, result.sigma[5] * kDegPerRad);
+  if (result.error_model) {
+    const georef::GnssErrorModel& model = *result.error_model;
+    fmt::print(
+        "error model: Gauss-Markov, correlation time {:g} s (configured {:g}), white share {:g}, "
+        "{:.0f} % of the reported sigmas' swings believed; observed errors {:.2f}x the reported "
+        "sigmas horizontally, {:.2f}x vertically; worth {:.1f} independent fixes\n",
+        model.correlation_time_s, model.configured_correlation_time_s, model.white_share,
+        100.0 * model.sigma_trust, model.sigma_scale_horizontal, model.sigma_scale_up,
+        model.independent_fixes);
+    // Whitened residuals still correlated: the errors drift for longer than even 3x tau.
+    constexpr double kMaxLagOneCorrelation = 0.3;
+    if (model.whitened_lag_one_correlation > kMaxLagOneCorrelation)
+      fmt::print(stderr,
+                 "taiga georef: warning: the GNSS errors stay correlated for longer than the "
+                 "error model allows (whitened lag-one correlation {:.2f}): the 1-sigma may be too "
+                 "small; raise georef.error_correlation_time_s (now {:g} s)\n",
+                 model.whitened_lag_one_correlation, model.configured_correlation_time_s);
+  }
   fmt::print("wrote {}\n", options.out);
   if (!result.converged) {
     fmt::print(stderr, "taiga georef: warning: {} did not converge in {} iterations\n",

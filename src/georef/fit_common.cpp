@@ -68,9 +68,10 @@ void finishFit(const std::vector<AssociatedFix>& pairs, const FitOptions& option
   fit.residual_rms_m = std::sqrt(sum3 / n);
   fit.horizontal_rms_m = std::sqrt(sum_h / n);
   fit.vertical_rms_m = std::sqrt(sum_v / n);
-  // Variance of the mean of m Gauss-Markov samples relative to white noise (fit.hpp).
+  // Variance of the mean of m Gauss-Markov samples relative to white noise (fit.hpp); a fit
+  // that models the correlation (robust) needs none.
   fit.correlation_inflation = 1.0;
-  if (options.error_correlation_time_s > 0.0 && fit.inliers > 0) {
+  if (!fit.error_model && options.error_correlation_time_s > 0.0 && fit.inliers > 0) {
     double sum = 0.0;
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       if (!fit.inlier[i]) continue;

@@ -86,6 +86,24 @@ void writeGridCsv(const std::filesystem::path& path, const std::vector<GridPose>
               pose.yaw_grid_deg);
 }
 
+void writeFixesCsv(const std::filesystem::path& path, const std::vector<AssociatedFix>& fixes,
+                   const GeorefFit& fit) {
+  auto out = fmt::output_file(path.string());
+  out.print(
+      "t_s,east_m,north_m,up_m,sigma_east_m,sigma_north_m,sigma_up_m,x_world_m,y_world_m,"
+      "z_world_m,residual_east_m,residual_north_m,residual_up_m,used\n");
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    const AssociatedFix& pair = fixes[i];
+    const Eigen::Vector3d sigma = pair.fix.covariance_enu_m2.diagonal().cwiseSqrt();
+    const Eigen::Vector3d residual = fit.T_enu_world * pair.p_world - pair.fix.p_enu;
+    const bool used = i < fit.inlier.size() && fit.inlier[i];
+    out.print("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", pair.fix.t_s, pair.fix.p_enu.x(),
+              pair.fix.p_enu.y(), pair.fix.p_enu.z(), sigma.x(), sigma.y(), sigma.z(),
+              pair.p_world.x(), pair.p_world.y(), pair.p_world.z(), residual.x(), residual.y(),
+              residual.z(), used ? 1 : 0);
+  }
+}
+
 void writeGeoJson(const std::filesystem::path& path, const std::vector<GridPose>& poses, int epsg,
                   const std::string& name) {
   // GeoJSON (RFC 7946) drops the "crs" member and means WGS84 longitude/latitude, but QGIS and
@@ -182,6 +200,30 @@ void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& repo
   out << YAML::Key << "horizontal" << YAML::Value << Exact{fit.horizontal_rms_m};
   out << YAML::Key << "vertical" << YAML::Value << Exact{fit.vertical_rms_m};
   out << YAML::EndMap;
+  if (fit.error_model) {
+    const GnssErrorModel& model = *fit.error_model;
+    emitCommentLines(out,
+                     "robust: the fixes' errors as the fit modelled them (reported sigma times a "
+                     "Gauss-Markov\nprocess); sigma above is the error this model expects for "
+                     "these fixes (docs/georeferencing.md)");
+    out << YAML::Key << "error_model" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "configured_correlation_time_s" << YAML::Value
+        << Exact{model.configured_correlation_time_s};
+    out << YAML::Key << "correlation_time_s" << YAML::Comment("the most likely")
+        << YAML::Value << Exact{model.correlation_time_s};
+    out << YAML::Key << "white_share" << YAML::Comment("white / Gauss-Markov variance")
+        << YAML::Value << Exact{model.white_share};
+    out << YAML::Key << "sigma_trust" << YAML::Comment("share of the reported sigmas' swings believed")
+        << YAML::Value << Exact{model.sigma_trust};
+    out << YAML::Key << "sigma_mean_window_s" << YAML::Value << Exact{model.sigma_mean_window_s};
+    out << YAML::Key << "sigma_scale_horizontal" << YAML::Comment("observed / reported")
+        << YAML::Value << Exact{model.sigma_scale_horizontal};
+    out << YAML::Key << "sigma_scale_up" << YAML::Value << Exact{model.sigma_scale_up};
+    out << YAML::Key << "independent_fixes" << YAML::Value << Exact{model.independent_fixes};
+    out << YAML::Key << "whitened_lag_one_correlation" << YAML::Comment("near 0 if tau is right")
+        << YAML::Value << Exact{model.whitened_lag_one_correlation};
+    out << YAML::EndMap;
+  }
   out << YAML::Key << "iterations" << YAML::Value << fit.iterations;
   out << YAML::Key << "converged" << YAML::Value << fit.converged;
   out << YAML::EndMap;

@@ -112,6 +112,7 @@ Georeference georeference(const Trajectory& trajectory, const GnssInput& input,
   report.in_gap = association.in_gap;
   report.associated = association.pairs.size();
   out.poses = trajectoryInGrid(trajectory, report.fit.T_enu_world, prepared.origin, converter);
+  out.fixes = association.pairs;
   return out;
 }
 
@@ -123,6 +124,7 @@ void writeGeoreference(const std::filesystem::path& dir, const Georeference& geo
   writeGeoJson(dir / "trajectory.geojson", georeference.poses, georeference.report.epsg,
                trajectory_name);
   writeGeorefYaml(dir / "georef.yaml", georeference.report);
+  writeFixesCsv(dir / "fixes.csv", georeference.fixes, georeference.report.fit);
 }
 
 }  // namespace taiga::georef

@@ -38,10 +38,20 @@ void OnlineGeoreferencer::associatePending() {
   const Association association = associateFixes(published_, ready, settings_.association);
   if (association.pairs.empty()) return;
   associated_.insert(associated_.end(), association.pairs.begin(), association.pairs.end());
+  // The error model is chosen again whenever the fixes have grown by a quarter since the last
+  // choice (a choice tries a hundred models; an hour of 1 Hz fixes refitted with all of them at
+  // every fix would cost minutes), and kept in between.
+  FitOptions options = settings_.fit;
+  const bool choose = !model_ || 4 * associated_.size() >= 5 * model_fixes_;
+  if (!choose) options.error_model = model_;
   try {
     estimate_ = OnlineEstimate{.t_s = associated_.back().fix.t_s,
                                .fixes = associated_.size(),
-                               .fit = fitRobust(associated_, settings_.fit)};
+                               .fit = fitRobust(associated_, options)};
+    if (choose) {
+      model_ = estimate_->fit.error_model;
+      model_fixes_ = associated_.size();
+    }
   } catch (const InputError&) {
     // Too few fixes, or too little motion for the heading yet: keep the previous estimate.
   }

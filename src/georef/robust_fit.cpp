@@ -12,17 +12,17 @@
 //   w_i = 1 / (1 + (u_i / (c k))^2),  u_i = |r_i| / s_i,  k = median(u) / 1.1774,
 // k being the robust scale of the normalized residual norms (1.1774 is the median of the norm of
 // a 2D unit Gaussian), which absorbs a receiver's optimistic sigmas. Fixes with
-// u_i / k > outlier_threshold (multipath jumps) are then outliers, and the final weighted fit
-// uses the inliers with Cauchy weights.
+// u_i / k > outlier_threshold (multipath jumps) are then outliers; a weighted fit of the
+// inliers starts the final estimate.
 //
-// Height offset: t_u from the height differences d_i = u_i - z_world,i with a Huber M-estimate
-// (weights min(1, h / |v_i|), v_i = (d_i - t_u) / (sigma_up,i k_u), k_u = 1.4826 MAD), starting
-// from the median; outliers as above.
+// Height offset: first a Huber M-estimate of the height differences d_i = u_i - z_world,i
+// (weights min(1, h / |v_i|), v_i = (d_i - t_u) / (sigma_up,i k_u), k_u = 1.4826 MAD), from the
+// median, only to screen outliers.
 //
-// Uncertainty: (psi, t_e, t_n) from the weighted normal equations of the final fit scaled by the
-// variance factor sigma0^2 = max(1, sum w_i |r_i|^2 / s_i^2 / (2m - 3)); t_u from
-// sigma0_u^2 / sum (w_i / sigma_up,i^2), sigma0_u^2 = max(1, sum w_i v_i^2 / (m - 1)); both then
-// inflated for correlated errors (fit.hpp).
+// The estimate and its uncertainty: generalized least squares of (t_e, t_n, psi) and t_u over
+// the inliers under the Gauss-Markov error model of the fixes (gauss_markov.hpp), which also
+// screens the multipath that plain residuals hide. Its covariance is the model's expected error
+// for these fixes, scaled by the whitened residuals; no further inflation for correlation.
 #include <algorithm>
 #include <cmath>
 
@@ -166,48 +166,24 @@ GeorefFit fitRobust(const std::vector<AssociatedFix>& pairs, const FitOptions& o
   } else {
     fit.inlier.assign(n, true);  // too few left to reject anything
   }
+
+  // Final estimate: generalized least squares on the inliers under the Gauss-Markov error model.
+  const GaussMarkovFit gls =
+      fitGaussMarkov(pairs, fit.inlier, horizontal.yaw_rad, horizontal.t,
+                     {.correlation_time_s = options.error_correlation_time_s,
+                      .outlier_sigmas = options.outlier_threshold,
+                      .model = options.error_model});
+  fit.inlier = gls.used;
   fit.outliers = n - static_cast<std::size_t>(std::count(fit.inlier.begin(), fit.inlier.end(), true));
-
-  // Final height offset over the inliers with their Huber weights.
-  double numerator = 0.0, denominator = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!fit.inlier[i]) continue;
-    numerator += huber[i] * height_difference[i] / (sigma_up[i] * sigma_up[i]);
-    denominator += huber[i] / (sigma_up[i] * sigma_up[i]);
-  }
-  t_up = numerator / denominator;
-
-  fit.T_enu_world = lie::SE3(lie::SO3::fromAxisAngle(Eigen::Vector3d::UnitZ(), horizontal.yaw_rad),
-                             Eigen::Vector3d(horizontal.t.x(), horizontal.t.y(), t_up));
-
-  // Uncertainty of (t_e, t_n, psi): weighted normal equations of the final fit.
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  double chi2 = 0.0, chi2_up = 0.0;
-  std::size_t m = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!fit.inlier[i]) continue;
-    const Eigen::Vector2d Ra = Eigen::Rotation2Dd(horizontal.yaw_rad) * a[i];
-    const Eigen::Vector2d r = Ra + horizontal.t - b[i];
-    Eigen::Matrix<double, 2, 3> J;
-    J << 1.0, 0.0, -Ra.y(),  //
-        0.0, 1.0, Ra.x();
-    const double w = cauchy[i] / s2[i];
-    H += w * J.transpose() * J;
-    chi2 += w * r.squaredNorm();
-    const double v = (height_difference[i] - t_up) / sigma_up[i];
-    chi2_up += huber[i] * v * v;
-    ++m;
-  }
-  const Eigen::Matrix3d horizontal_covariance =
-      std::max(1.0, chi2 / std::max(1.0, 2.0 * static_cast<double>(m) - 3.0)) *
-      H.ldlt().solve(Eigen::Matrix3d::Identity());
+  fit.T_enu_world = lie::SE3(lie::SO3::fromAxisAngle(Eigen::Vector3d::UnitZ(), gls.yaw_rad),
+                             Eigen::Vector3d(gls.t.x(), gls.t.y(), gls.t_up));
   const int index[3] = {0, 1, 5};  // east, north, yaw in the 6-DoF parameter order
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) fit.covariance(index[r], index[c]) = horizontal_covariance(r, c);
-  fit.covariance(2, 2) =
-      std::max(1.0, chi2_up / std::max(1.0, static_cast<double>(m) - 1.0)) / denominator;
+    for (int c = 0; c < 3; ++c) fit.covariance(index[r], index[c]) = gls.horizontal_covariance(r, c);
+  fit.covariance(2, 2) = gls.up_variance;
   fit.covariance(3, 3) = fit.covariance(4, 4) =
       options.gravity_tilt_sigma_rad * options.gravity_tilt_sigma_rad;
+  fit.error_model = gls.model;
   detail::finishFit(pairs, options, fit);
   return fit;
 }

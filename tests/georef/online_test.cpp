@@ -100,7 +100,11 @@ TEST(OnlineGeoreferencer, EndsWithTheOfflineRobustFitOfTheSameFixes) {
   const Walk walk = makeWalk();
   OnlineGeoreferencer online(whiteNoiseSettings());
   feed(online, walk, lie::SE3());
-  const GeorefSettings settings = whiteNoiseSettings();
+  ASSERT_TRUE(online.estimate().has_value());
+  ASSERT_TRUE(online.estimate()->fit.error_model.has_value());
+  // The same fixes under the error model the online estimator chose last.
+  GeorefSettings settings = whiteNoiseSettings();
+  settings.fit.error_model = online.estimate()->fit.error_model;
   const geo::CoordinateConverter converter(settings.epsg);
   const PreparedFixes prepared = prepareFixes(walk.fixes, settings.gating, converter);
   const Association offline = associateFixes(walk.poses, prepared.fixes, settings.association);

@@ -44,6 +44,17 @@ struct NoiseModel {
   int burst_fixes = 3;
   Eigen::Vector3d jump_m = Eigen::Vector3d(18.0, -9.0, 12.0);
   unsigned seed = 7;
+  /// The sigma of each fix swings by up to this share around the sigmas above, uniformly at
+  /// random from fix to fix (canopy cover changing under a walker).
+  double sigma_swing = 0.0;
+  /// true: a fix's error is its own sigma times the (unit) Gauss-Markov state; false: the
+  /// sigmas above times the state, whatever the fix's sigma (errors that do not follow it).
+  bool errors_follow_sigma = true;
+  /// Reported sigma / true sigma (< 1: an optimistic receiver).
+  double reported_sigma_factor = 1.0;
+  /// The reported sigma is further off by a factor exp(N(0, this^2)), independently per fix (a
+  /// receiver's sigma is itself an estimate).
+  double reported_sigma_noise = 0.0;
 };
 
 struct SyntheticFixes {
@@ -75,14 +86,21 @@ inline SyntheticFixes synthesizeFixes(const Trajectory& trajectory, const lie::S
       markov = white;
     }
     first = false;
-    const Eigen::Vector3d error(noise.sigma_horizontal_m * markov.x(),
-                                noise.sigma_horizontal_m * markov.y(),
-                                noise.sigma_vertical_m * markov.z());
+    // (No draw without a swing: the other tests keep their random sequences.)
+    const double swing =
+        noise.sigma_swing > 0.0 ? 1.0 + noise.sigma_swing * (2.0 * uniform(random) - 1.0) : 1.0;
+    const double sigma_h = swing * noise.sigma_horizontal_m, sigma_v = swing * noise.sigma_vertical_m;
+    const double error_scale = noise.errors_follow_sigma ? swing : 1.0;
+    const Eigen::Vector3d error(error_scale * noise.sigma_horizontal_m * markov.x(),
+                                error_scale * noise.sigma_horizontal_m * markov.y(),
+                                error_scale * noise.sigma_vertical_m * markov.z());
     pair.fix.p_enu = T_enu_world * pair.p_world + error;
+    const double f = noise.reported_sigma_factor *
+                     (noise.reported_sigma_noise > 0.0
+                          ? std::exp(noise.reported_sigma_noise * gauss(random))
+                          : 1.0);
     pair.fix.covariance_enu_m2 =
-        Eigen::Vector3d(noise.sigma_horizontal_m * noise.sigma_horizontal_m,
-                        noise.sigma_horizontal_m * noise.sigma_horizontal_m,
-                        noise.sigma_vertical_m * noise.sigma_vertical_m)
+        Eigen::Vector3d(f * f * sigma_h * sigma_h, f * f * sigma_h * sigma_h, f * f * sigma_v * sigma_v)
             .asDiagonal();
     if (burst_left == 0 && uniform(random) < noise.multipath_share) burst_left = noise.burst_fixes;
     const bool jumped = burst_left > 0;

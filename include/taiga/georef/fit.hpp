@@ -20,14 +20,15 @@
 // small rotations about the ENU axes (east = roll, north = pitch, up = yaw) applied on the left:
 // T_enu_world' = (Exp(dtheta) R, t + dt). `covariance` is over [dt; dtheta]; `sigma` is its
 // square-rooted diagonal. Covariances come from the (weighted) normal equations scaled by the
-// a-posteriori variance factor (the residuals' own spread; for pf3, pf6 and robust never below 1,
+// a-posteriori variance factor (the residuals' own spread; for pf3 and pf6 never below 1,
 // so residuals that look better than the reported covariance do not shrink it), so an optimistic
 // receiver does not make the fit look better than it is. GNSS errors under canopy are correlated
-// over tens of seconds, which the least-squares fits ignore: the covariance is then inflated by
+// over tens of seconds, which closed, pf3 and pf6 ignore: their covariance is then inflated by
 // f = (1/m) sum_i sum_j exp(-|t_i - t_j| / tau) over the m fixes used, the variance of the mean of
 // m samples of a first-order Gauss-Markov error with correlation time tau relative to white noise
-// (f = 1 for tau = 0, f = m when all fixes fall within much less than tau). It is exact for the
-// translation of a fit that is an average and an approximation for the rotations.
+// (f = 1 for tau = 0, f = m when all fixes fall within much less than tau): exact for the
+// translation of a fit that is an average, an approximation for the rotations. robust models the
+// correlation instead (gauss_markov.hpp): its covariance is the error model's own.
 
 #include <Eigen/Core>
 #include <optional>
@@ -35,6 +36,7 @@
 #include <vector>
 
 #include "taiga/georef/association.hpp"
+#include "taiga/georef/gauss_markov.hpp"
 #include "taiga/lie/se3.hpp"
 
 namespace taiga::georef {
@@ -68,6 +70,9 @@ struct FitOptions {
   /// Correlation time of the GNSS errors, s (0: white noise); see the header comment. 30 s is
   /// typical under canopy (and the simulator's value).
   double error_correlation_time_s = 30.0;
+  /// robust: fit with this error model instead of choosing the most likely around
+  /// error_correlation_time_s (gauss_markov.hpp); the online estimator between its choices.
+  std::optional<GnssErrorModel> error_model;
   int max_iterations = 50;
   /// Gauss-Newton and IRLS stop when the update is below this (m and rad).
   double convergence_step = 1e-9;
@@ -89,8 +94,10 @@ struct GeorefFit {
   std::size_t without_orientation = 0;
   /// Residuals T_enu_world * p_world - p_enu over the inliers, m.
   double residual_rms_m = 0.0;
-  /// The covariance inflation f for correlated errors (1: none).
+  /// The covariance inflation f for correlated errors (1: none; robust models them instead).
   double correlation_inflation = 1.0;
+  /// robust: the error model of the fixes as the fit found it (gauss_markov.hpp).
+  std::optional<GnssErrorModel> error_model;
   double horizontal_rms_m = 0.0;
   double vertical_rms_m = 0.0;
   int iterations = 0;

@@ -49,6 +49,11 @@ void writeGridCsv(const std::filesystem::path& path, const std::vector<GridPose>
 void writeGeoJson(const std::filesystem::path& path, const std::vector<GridPose>& poses, int epsg,
                   const std::string& name);
 void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& report);
+/// fixes.csv: per fitted fix its time, position and reported 1-sigma in the fit's ENU frame, the
+/// antenna in the world frame, the residual T_enu_world * p_world - p_enu and whether the fit
+/// used it (0: an outlier or not used by the method).
+void writeFixesCsv(const std::filesystem::path& path, const std::vector<AssociatedFix>& fixes,
+                   const GeorefFit& fit);
 
 /// The grid a georef.yaml places the world (map) frame in: its EPSG code and T_epsg_world.
 struct GeorefGrid {

@@ -33,6 +33,7 @@ GeorefSettings settingsFrom(const GeorefConfig& config);
 struct Georeference {
   GeorefReport report;          ///< what georef.yaml holds, the fit included
   std::vector<GridPose> poses;  ///< every pose of the trajectory in the projected CRS
+  std::vector<AssociatedFix> fixes;  ///< the fixes fitted (report.fit.inlier tells the used ones)
 };
 
 /// `trajectory_name` and `gnss_name` only name the inputs in messages and in the report. pf6
@@ -41,7 +42,7 @@ Georeference georeference(const Trajectory& trajectory, const GnssInput& input,
                           const GeorefSettings& settings, const RigConfig& rig,
                           const std::string& trajectory_name, const std::string& gnss_name);
 
-/// Writes DIR/trajectory_epsgNNNN.csv, DIR/trajectory.geojson and DIR/georef.yaml.
+/// Writes DIR/trajectory_epsgNNNN.csv, DIR/trajectory.geojson, DIR/georef.yaml and DIR/fixes.csv.
 void writeGeoreference(const std::filesystem::path& dir, const Georeference& georeference,
                        const std::string& trajectory_name);
 

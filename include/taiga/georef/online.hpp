@@ -6,8 +6,9 @@
 //
 // A fix is associated once the odometry has published poses past its time (the published poses
 // do not change afterwards); each associated fix refits the `robust` method (fit.hpp) over all
-// fixes so far, which costs well under a millisecond for an hour of 1 Hz fixes. Until the walk
-// spans enough ground for the heading (fitRobust's own test) there is no estimate.
+// fixes so far, with the error model it chose last (chosen again when the fixes have grown by a
+// quarter). Until the walk spans enough ground for the heading (fitRobust's own test) there is
+// no estimate.
 
 #include <optional>
 #include <vector>
@@ -53,6 +54,8 @@ class OnlineGeoreferencer {
   std::vector<LocalFix> pending_;  ///< not yet covered by published poses
   std::vector<AssociatedFix> associated_;
   std::optional<OnlineEstimate> estimate_;
+  std::optional<GnssErrorModel> model_;  ///< the robust fit's error model, last chosen at
+  std::size_t model_fixes_ = 0;          ///< this many associated fixes
   std::size_t gated_ = 0;
 };
 
