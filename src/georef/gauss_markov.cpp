@@ -83,7 +83,8 @@ class Whitener {
     for (std::size_t k = 0; k < t_s.size(); ++k) {
       Step step;
       step.phi = k > 0 && tau_s > 0.0 ? std::exp(-(t_s[k] - t_s[k - 1]) / tau_s) : 0.0;
-      const double P_predicted = k == 0 ? 1.0 : step.phi * step.phi * P + (1.0 - step.phi * step.phi);
+      const double P_predicted =
+          k == 0 ? 1.0 : step.phi * step.phi * P + (1.0 - step.phi * step.phi);
       const double S = P_predicted + white_share;  // the innovation's variance
       step.inv_sqrt_s = 1.0 / std::sqrt(S);
       step.gain = P_predicted / S;
@@ -148,8 +149,8 @@ HorizontalSystem horizontalSystem(const Series& series, const std::vector<double
     Eigen::Matrix<double, 2, 3> J;
     J << 1.0, 0.0, -Ra.y(),  //
         0.0, 1.0, Ra.x();
-    const Eigen::Vector2d w = whitener.whiten<Eigen::Vector2d>(
-        k, (Ra + t - series.b_enu[k]) / sigma[k], residual_state);
+    const Eigen::Vector2d w =
+        whitener.whiten<Eigen::Vector2d>(k, (Ra + t - series.b_enu[k]) / sigma[k], residual_state);
     const Eigen::Matrix<double, 2, 3> Jw =
         whitener.whiten<Eigen::Matrix<double, 2, 3>>(k, J / sigma[k], jacobian_state);
     system.H += Jw.transpose() * Jw;
@@ -230,10 +231,10 @@ Candidate fitCandidate(const Series& series, const GnssErrorModel& model, double
   fit.up_variance = scale2_up / xx;
 
   constexpr double kTiny = 1e-300;  // exact data
-  candidate.log_likelihood =
-      -m * std::log(std::max(system.rss / (2.0 * m), kTiny)) - whitener.logDeterminant() -
-      2.0 * sumOfLogs(sigma_h) - 0.5 * m * std::log(std::max(rss_up / m, kTiny)) -
-      0.5 * whitener.logDeterminant() - sumOfLogs(sigma_up);
+  candidate.log_likelihood = -m * std::log(std::max(system.rss / (2.0 * m), kTiny)) -
+                             whitener.logDeterminant() - 2.0 * sumOfLogs(sigma_h) -
+                             0.5 * m * std::log(std::max(rss_up / m, kTiny)) -
+                             0.5 * whitener.logDeterminant() - sumOfLogs(sigma_up);
 
   fit.model.sigma_scale_horizontal = std::sqrt(scale2_h);
   fit.model.sigma_scale_up = std::sqrt(scale2_up);
@@ -260,8 +261,8 @@ Candidate mostLikely(const Series& series, const GaussMarkovOptions& options, do
                      const Eigen::Vector2d& start_t) {
   if (options.model) return fitCandidate(series, *options.model, start_yaw_rad, start_t);
   const double tau_s = options.correlation_time_s;
-  const std::vector<double> taus = tau_s > 0.0 ? std::vector<double>{tau_s / 3.0, tau_s, 3.0 * tau_s}
-                                               : std::vector<double>{0.0};
+  const std::vector<double> taus =
+      tau_s > 0.0 ? std::vector<double>{tau_s / 3.0, tau_s, 3.0 * tau_s} : std::vector<double>{0.0};
   const std::vector<double> white_shares =
       tau_s > 0.0 ? std::vector<double>{0.0, 0.03, 0.1, 0.3} : std::vector<double>{0.0};
   constexpr double kWholeWalk = std::numeric_limits<double>::infinity();

@@ -209,12 +209,13 @@ void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& repo
     out << YAML::Key << "error_model" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "configured_correlation_time_s" << YAML::Value
         << Exact{model.configured_correlation_time_s};
-    out << YAML::Key << "correlation_time_s" << YAML::Comment("the most likely")
-        << YAML::Value << Exact{model.correlation_time_s};
+    out << YAML::Key << "correlation_time_s" << YAML::Comment("the most likely") << YAML::Value
+        << Exact{model.correlation_time_s};
     out << YAML::Key << "white_share" << YAML::Comment("white / Gauss-Markov variance")
         << YAML::Value << Exact{model.white_share};
-    out << YAML::Key << "sigma_trust" << YAML::Comment("share of the reported sigmas' swings believed")
-        << YAML::Value << Exact{model.sigma_trust};
+    out << YAML::Key << "sigma_trust"
+        << YAML::Comment("share of the reported sigmas' swings believed") << YAML::Value
+        << Exact{model.sigma_trust};
     out << YAML::Key << "sigma_mean_window_s" << YAML::Value << Exact{model.sigma_mean_window_s};
     out << YAML::Key << "sigma_scale_horizontal" << YAML::Comment("observed / reported")
         << YAML::Value << Exact{model.sigma_scale_horizontal};

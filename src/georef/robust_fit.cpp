@@ -168,18 +168,19 @@ GeorefFit fitRobust(const std::vector<AssociatedFix>& pairs, const FitOptions& o
   }
 
   // Final estimate: generalized least squares on the inliers under the Gauss-Markov error model.
-  const GaussMarkovFit gls =
-      fitGaussMarkov(pairs, fit.inlier, horizontal.yaw_rad, horizontal.t,
-                     {.correlation_time_s = options.error_correlation_time_s,
-                      .outlier_sigmas = options.outlier_threshold,
-                      .model = options.error_model});
+  const GaussMarkovFit gls = fitGaussMarkov(pairs, fit.inlier, horizontal.yaw_rad, horizontal.t,
+                                            {.correlation_time_s = options.error_correlation_time_s,
+                                             .outlier_sigmas = options.outlier_threshold,
+                                             .model = options.error_model});
   fit.inlier = gls.used;
-  fit.outliers = n - static_cast<std::size_t>(std::count(fit.inlier.begin(), fit.inlier.end(), true));
+  fit.outliers =
+      n - static_cast<std::size_t>(std::count(fit.inlier.begin(), fit.inlier.end(), true));
   fit.T_enu_world = lie::SE3(lie::SO3::fromAxisAngle(Eigen::Vector3d::UnitZ(), gls.yaw_rad),
                              Eigen::Vector3d(gls.t.x(), gls.t.y(), gls.t_up));
   const int index[3] = {0, 1, 5};  // east, north, yaw in the 6-DoF parameter order
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) fit.covariance(index[r], index[c]) = gls.horizontal_covariance(r, c);
+    for (int c = 0; c < 3; ++c)
+      fit.covariance(index[r], index[c]) = gls.horizontal_covariance(r, c);
   fit.covariance(2, 2) = gls.up_variance;
   fit.covariance(3, 3) = fit.covariance(4, 4) =
       options.gravity_tilt_sigma_rad * options.gravity_tilt_sigma_rad;

@@ -287,7 +287,8 @@ TEST(GeorefFit, RobustModelsCorrelatedErrorsAndItsSigmasCoverThem) {
   noise.reported_sigma_factor = 0.7;
   const FitOptions modelled{.error_correlation_time_s = 30.0};
   const Spread robust = spreadOver(40, noise, modelled, fitRobust);
-  // Calibrated: about 68 % within 1 sigma and 95 % within 2 (160 errors: +-7 % is 2 binomial sigmas).
+  // Calibrated: about 68 % within 1 sigma and 95 % within 2 (160 errors: +-7 % is 2 binomial
+  // sigmas).
   EXPECT_GT(robust.within_1_sigma, 0.55);
   EXPECT_LT(robust.within_1_sigma, 0.82);
   EXPECT_GT(robust.within_2_sigma, 0.88);
@@ -326,7 +327,8 @@ TEST(GeorefFit, RobustSigmasStayHonestWhenTheErrorsDoNotFollowTheReportedSigma) 
   noise.correlation_time_s = 30.0;
   noise.sigma_swing = 0.6;
   noise.errors_follow_sigma = false;
-  const Spread robust = spreadOver(40, noise, FitOptions{.error_correlation_time_s = 30.0}, fitRobust);
+  const Spread robust =
+      spreadOver(40, noise, FitOptions{.error_correlation_time_s = 30.0}, fitRobust);
   EXPECT_GT(robust.smoothed, 30);
   EXPECT_GT(robust.within_1_sigma, 0.5);
   EXPECT_GT(robust.within_2_sigma, 0.85);

@@ -167,7 +167,8 @@ TEST(GeorefCli, RobustMethodOnCanopyDegradedGnssStaysWithinTheNoiseAndItsReporte
                      (sim / "recording.bag").string() + " --out " + again.string())
                 .exit_code,
             0);
-  for (const char* file : {"georef.yaml", "trajectory_epsg3067.csv", "trajectory.geojson", "fixes.csv"})
+  for (const char* file :
+       {"georef.yaml", "trajectory_epsg3067.csv", "trajectory.geojson", "fixes.csv"})
     EXPECT_EQ(readText(out / file), readText(again / file)) << file;
 }
 
@@ -182,8 +183,9 @@ TEST(GeorefCli, RobustModelsTheCanopyErrorsOfAWholeLoopNearTheirInformationLimit
     const auto overrides = dir.write("stride.yaml", "output: {scan_stride: 1000}\n");
     const auto sim = dir.file("sim");
     ASSERT_EQ(runTaiga("simulate --scenario handheld-loop --beams 16 --columns 512 --sub-rays 1 "
-                       "--seed " + std::to_string(seed) + " --overrides " + overrides.string() +
-                       " --out " + sim.string())
+                       "--seed " +
+                       std::to_string(seed) + " --overrides " + overrides.string() + " --out " +
+                       sim.string())
                   .exit_code,
               0);
     const auto out = dir.file("out");

@@ -89,18 +89,20 @@ inline SyntheticFixes synthesizeFixes(const Trajectory& trajectory, const lie::S
     // (No draw without a swing: the other tests keep their random sequences.)
     const double swing =
         noise.sigma_swing > 0.0 ? 1.0 + noise.sigma_swing * (2.0 * uniform(random) - 1.0) : 1.0;
-    const double sigma_h = swing * noise.sigma_horizontal_m, sigma_v = swing * noise.sigma_vertical_m;
+    const double sigma_h = swing * noise.sigma_horizontal_m,
+                 sigma_v = swing * noise.sigma_vertical_m;
     const double error_scale = noise.errors_follow_sigma ? swing : 1.0;
     const Eigen::Vector3d error(error_scale * noise.sigma_horizontal_m * markov.x(),
                                 error_scale * noise.sigma_horizontal_m * markov.y(),
                                 error_scale * noise.sigma_vertical_m * markov.z());
     pair.fix.p_enu = T_enu_world * pair.p_world + error;
-    const double f = noise.reported_sigma_factor *
-                     (noise.reported_sigma_noise > 0.0
-                          ? std::exp(noise.reported_sigma_noise * gauss(random))
-                          : 1.0);
+    const double f =
+        noise.reported_sigma_factor * (noise.reported_sigma_noise > 0.0
+                                           ? std::exp(noise.reported_sigma_noise * gauss(random))
+                                           : 1.0);
     pair.fix.covariance_enu_m2 =
-        Eigen::Vector3d(f * f * sigma_h * sigma_h, f * f * sigma_h * sigma_h, f * f * sigma_v * sigma_v)
+        Eigen::Vector3d(f * f * sigma_h * sigma_h, f * f * sigma_h * sigma_h,
+                        f * f * sigma_v * sigma_v)
             .asDiagonal();
     if (burst_left == 0 && uniform(random) < noise.multipath_share) burst_left = noise.burst_fixes;
     const bool jumped = burst_left > 0;
