@@ -35,6 +35,18 @@ std::string withUnit(double value, std::string_view unit) {
 
 }  // namespace
 
+std::span<const MovedConfigKey> movedConfigKeys() {
+  // Issue 23: the GNSS fusion and the post-fit georeferencing had a setting each for the same
+  // receiver; one is kept.
+  static constexpr MovedConfigKey kMoved[] = {
+      {"mapping.gnss_max_horizontal_sigma_m", "georef.max_horizontal_sigma_m",
+       "one gate for the GNSS fusion and the georeferencing"},
+      {"mapping.gnss_correlation_time_s", "georef.error_correlation_time_s",
+       "one GNSS error model for the fusion and the georeferencing"},
+  };
+  return kMoved;
+}
+
 void validateAll(ConfigSection& root) {
   root.validate();
   ValidatingVisitor visitor;

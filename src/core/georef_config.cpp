@@ -12,20 +12,23 @@ void GeorefConfig::visit(ConfigVisitor& v) {
            "pf6 (positions and the IMU's absolute orientation)");
   v.field("epsg", epsg, "EPSG code of the projected CRS of the outputs (3067: ETRS-TM35FIN)");
   v.field("max_horizontal_sigma_m", max_horizontal_sigma_m,
-          "m, fixes whose reported horizontal 1-sigma is larger are not used");
+          "m, fixes whose reported horizontal 1-sigma is larger are not used (here and by "
+          "mapping.gnss_fusion)");
   v.field("max_gap_s", max_gap_s,
           "s, fixes between trajectory poses further apart than this are not used");
   v.field("error_correlation_time_s", error_correlation_time_s,
-          "s, correlation time of the GNSS errors (about 30 s under canopy; 0: white noise); "
-          "widens the reported uncertainty");
-  v.field("p_body_antenna_m", p_body_antenna_m, "m, GNSS antenna position in the body frame");
+          "s, correlation time of the GNSS errors (about 30 s under canopy; 0: white noise): the "
+          "robust fit's error model starts from it, the other fits and mapping.gnss_fusion "
+          "weight by it");
+  v.field("p_body_antenna_m", p_body_antenna_m,
+          "m, GNSS antenna position in the body frame (here and in mapping.gnss_fusion)");
 }
 
 void GeorefConfig::validate() const {
   requireInRange("epsg", epsg, 1024, 999999, "");
   requirePositive("max_horizontal_sigma_m", max_horizontal_sigma_m, "m");
   requirePositive("max_gap_s", max_gap_s, "s");
-  requireNonNegative("error_correlation_time_s", error_correlation_time_s, "s");
+  requireInRange("error_correlation_time_s", error_correlation_time_s, 0.0, 3600.0, "s");
 }
 
 }  // namespace taiga

@@ -45,12 +45,8 @@ void MappingConfig::visit(ConfigVisitor& v) {
           "rad per m travelled between the keyframes, added to that sigma");
   v.field("gnss_fusion", gnss_fusion,
           "fuse GNSS fixes into the graph, estimating the map-to-ENU yaw and translation");
-  v.field("gnss_max_horizontal_sigma_m", gnss_max_horizontal_sigma_m,
-          "m, fixes reporting a larger horizontal 1-sigma are not fused");
   v.field("gnss_huber_sigmas", gnss_huber_sigmas,
           "sigmas of the reported covariance beyond which a fix is down-weighted (Huber)");
-  v.field("gnss_correlation_time_s", gnss_correlation_time_s,
-          "s, correlation time of the GNSS errors; fixes are down-weighted accordingly (0: white)");
   v.field("gnss_min_fixes", gnss_min_fixes,
           "fixes needed before GNSS factors enter the graph (the heading must be observable)");
   v.field("gnss_min_spread_m", gnss_min_spread_m,
@@ -77,9 +73,7 @@ void MappingConfig::validate() const {
   requireNonNegative("odometry_sigma_m_per_m", odometry_sigma_m_per_m, "m/m");
   requirePositive("odometry_sigma_rad", odometry_sigma_rad, "rad");
   requireNonNegative("odometry_sigma_rad_per_m", odometry_sigma_rad_per_m, "rad/m");
-  requirePositive("gnss_max_horizontal_sigma_m", gnss_max_horizontal_sigma_m, "m");
   requirePositive("gnss_huber_sigmas", gnss_huber_sigmas, "sigmas");
-  requireInRange("gnss_correlation_time_s", gnss_correlation_time_s, 0.0, 3600.0, "s");
   requireInRange("gnss_min_fixes", gnss_min_fixes, 3, 100000, "fixes");
   requireNonNegative("gnss_min_spread_m", gnss_min_spread_m, "m");
   requireNonNegative("gnss_optimize_interval_s", gnss_optimize_interval_s, "s");

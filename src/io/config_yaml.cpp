@@ -89,6 +89,11 @@ class Mapping {
   void rejectUnknownKeys() const {
     for (const Entry& entry : entries_) {
       if (std::find(known_.begin(), known_.end(), entry.key) != known_.end()) continue;
+      for (const MovedConfigKey& moved : movedConfigKeys()) {
+        if (moved.old_key == prefix_ + entry.key)
+          fail(entry.key_node.Mark(), entry.key,
+               fmt::format("moved to {} ({})", moved.new_key, moved.why));
+      }
       std::string hint;
       std::size_t best = entry.key.size() / 3 + 2;  // suggest only plausible typos
       for (const std::string& candidate : known_) {

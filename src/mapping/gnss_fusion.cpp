@@ -20,9 +20,11 @@ double correlationFactor(double dt_s, double tau_s) {
 
 }  // namespace
 
-GnssFusion::GnssFusion(const MappingConfig& config)
+GnssFusion::GnssFusion(const MappingConfig& config, const GeorefConfig& gnss)
     : config_(config),
-      gating_{.max_horizontal_sigma_m = config.gnss_max_horizontal_sigma_m},
+      correlation_time_s_(gnss.error_correlation_time_s),
+      p_body_antenna_m_(gnss.p_body_antenna_m),
+      gating_{.max_horizontal_sigma_m = gnss.max_horizontal_sigma_m},
       converter_(3067) {}  // only its ENU conversion (through ECEF) is used, any EPSG code does
 
 void GnssFusion::addFix(const GnssFix& fix) {
@@ -48,11 +50,12 @@ void GnssFusion::attach(const georef::LocalFix& fix, const PoseGraph& graph,
   const double s = span_s > 0.0 ? (fix.t_s - keyframe_times_s[a]) / span_s : 0.0;
   const lie::SE3 T_odom_fix = lie::interpolate(graph.odometryPose(a), graph.odometryPose(b), s);
   const std::size_t nearest = s <= 0.5 ? a : b;
-  // The antenna (at the body origin: no lever arm yet) in the nearest keyframe's body frame.
-  const Eigen::Vector3d d_body = (graph.odometryPose(nearest).inverse() * T_odom_fix).translation();
+  // The antenna in the nearest keyframe's body frame.
+  const Eigen::Vector3d d_body =
+      graph.odometryPose(nearest).inverse() * T_odom_fix * p_body_antenna_m_;
 
   const double dt_s =
-      previous_fix_t_s_ ? std::abs(fix.t_s - *previous_fix_t_s_) : config_.gnss_correlation_time_s;
+      previous_fix_t_s_ ? std::abs(fix.t_s - *previous_fix_t_s_) : correlation_time_s_;
   previous_fix_t_s_ = fix.t_s;
   Attached attached{
       .observation = {.keyframe = nearest,
@@ -60,7 +63,7 @@ void GnssFusion::attach(const georef::LocalFix& fix, const PoseGraph& graph,
                       .p_enu = fix.p_enu,
                       .covariance_enu_m2 = fix.covariance_enu_m2,
                       .huber_sigmas = config_.gnss_huber_sigmas,
-                      .weight = 1.0 / correlationFactor(dt_s, config_.gnss_correlation_time_s)},
+                      .weight = 1.0 / correlationFactor(dt_s, correlation_time_s_)},
       .t_s = fix.t_s};
   attached_.push_back(attached);
 }
@@ -109,7 +112,7 @@ void GnssFusion::tryStart(PoseGraph& graph) {
   if (spread_m < config_.gnss_min_spread_m) return;
 
   georef::FitOptions options;
-  options.error_correlation_time_s = config_.gnss_correlation_time_s;
+  options.error_correlation_time_s = correlation_time_s_;
   try {
     const georef::GeorefFit fit = georef::fitRobust(pairs, options);
     graph.setEnuMap(fit.T_enu_world);

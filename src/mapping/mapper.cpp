@@ -11,13 +11,13 @@
 namespace taiga::mapping {
 
 Mapper::Mapper(const MappingConfig& config, const OdometryConfig& odometry,
-               const KeyframeStore& store, LoopVerifier verify_loop)
+               const KeyframeStore& store, LoopVerifier verify_loop, const GeorefConfig& gnss)
     : config_(config),
       odometry_(odometry),
       store_(store),
       verify_loop_(std::move(verify_loop)),
       graph_(config) {
-  if (config.gnss_fusion) gnss_.emplace(config);
+  if (config.gnss_fusion) gnss_.emplace(config, gnss);
 }
 
 void Mapper::addKeyframe(std::size_t id, double t_s, const lie::SE3& T_odom_body,
@@ -142,7 +142,9 @@ void Mapper::tryLoopClosure(std::size_t current, double t_s) {
 
 MappingThread::MappingThread(const MappingConfig& config, const OdometryConfig& odometry,
                              const KeyframeStore& store, MappingThreadOptions options)
-    : mapper_(config, odometry, store), options_(std::move(options)), worker_([this] { work(); }) {}
+    : mapper_(config, odometry, store, verifyLoop, options.gnss),
+      options_(std::move(options)),
+      worker_([this] { work(); }) {}
 
 MappingThread::~MappingThread() {
   {

@@ -17,6 +17,7 @@ mapping::MappingThreadOptions mappingThreadOptions(const SystemConfig& config,
                                                    const mapping::KeyframeStore& store,
                                                    const std::vector<SlamObserver*>& observers) {
   mapping::MappingThreadOptions out;
+  out.gnss = config.georef;
   // The snapshots the odometry follows (step 11), as many as its local map holds.
   if (config.mapping.correct_odometry)
     out.snapshot_keyframes = static_cast<std::size_t>(config.odometry.local_map_keyframes);

@@ -176,6 +176,14 @@ TEST(Cli, ConfigPrintsDefaultsAndNamesBadKeys) {
   EXPECT_THAT(r.output, HasSubstr("taiga: error: " + typo.string() +
                                   ":4:3: rig.lidar_offset_s: unknown key"));
 
+  // A key that moved says where to (issue 23: one GNSS setting for fusion and georef).
+  const auto moved = dir.write("moved.yaml", "mapping:\n  gnss_correlation_time_s: 60\n");
+  const Result moved_result = runTaiga("config " + moved.string());
+  EXPECT_EQ(moved_result.exit_code, 2);
+  EXPECT_THAT(moved_result.output,
+              HasSubstr(":2:3: mapping.gnss_correlation_time_s: moved to "
+                        "georef.error_correlation_time_s"));
+
   const auto good = dir.write("good.yaml", "rig:\n  T_body_lidar:\n    rpy_deg: [0, 0, 180]\n");
   const Result ok = runTaiga("config " + good.string());
   EXPECT_EQ(ok.exit_code, 0);

@@ -56,6 +56,7 @@ std::vector<lie::SE3> driftingOdometry(const std::vector<lie::SE3>& truth) {
 }
 
 struct FixNoise {
+  Eigen::Vector3d p_body_antenna_m = Eigen::Vector3d::Zero();  ///< where the fixes are taken
   double sigma_horizontal_m = 0.5;
   double sigma_vertical_m = 0.9;
   std::size_t burst_begin = 0, burst_end = 0;  ///< fixes in [begin, end) jump by burst_m
@@ -71,7 +72,8 @@ std::vector<GnssFix> fixesFor(const std::vector<lie::SE3>& truth, const FixNoise
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::vector<GnssFix> fixes;
   for (std::size_t k = 0; k + 1 < truth.size(); ++k) {
-    const Eigen::Vector3d p_world = lie::interpolate(truth[k], truth[k + 1], 0.5).translation();
+    const Eigen::Vector3d p_world =
+        lie::interpolate(truth[k], truth[k + 1], 0.5) * noise.p_body_antenna_m;
     Eigen::Vector3d p_enu = kTrueEnuWorld * p_world;
     p_enu +=
         Eigen::Vector3d(noise.sigma_horizontal_m * gauss(rng),
@@ -99,8 +101,14 @@ MappingConfig fusionConfig() {
   MappingConfig config;
   config.loop_closure = false;
   config.gnss_fusion = true;
-  config.gnss_correlation_time_s = 0.0;  // the synthetic noise is white
   return config;
+}
+
+/// The receiver's settings (the georef section): the synthetic noise is white.
+GeorefConfig whiteGnss() {
+  GeorefConfig gnss;
+  gnss.error_correlation_time_s = 0.0;
+  return gnss;
 }
 
 struct Fused {
@@ -110,9 +118,9 @@ struct Fused {
 
 // Keyframes and fixes interleaved by time, as taiga run hands them over, then the final solve.
 Fused fuse(const MappingConfig& config, const std::vector<lie::SE3>& odometry,
-           const std::vector<GnssFix>& fixes) {
+           const std::vector<GnssFix>& fixes, const GeorefConfig& gnss = whiteGnss()) {
   PoseGraph graph(config);
-  GnssFusion fusion(config);
+  GnssFusion fusion(config, gnss);
   std::vector<double> times_s;
   std::size_t next_fix = 0;
   for (std::size_t k = 0; k < odometry.size(); ++k) {
@@ -272,8 +280,8 @@ TEST(GnssFusion, MappingThreadGivesTheInlineResultBitForBit) {
   const std::vector<lie::SE3> truth = trueRectangle();
   const std::vector<lie::SE3> odometry = driftingOdometry(truth);
   const std::vector<GnssFix> fixes = fixesFor(truth, multipathBurst(), 4);
-  MappingConfig config = fusionConfig();
-  config.gnss_correlation_time_s = 30.0;  // the weighting path too
+  const MappingConfig config = fusionConfig();
+  const GeorefConfig gnss;  // tau 30 s: the weighting path too
   const KeyframeStore store = KeyframeStore::create(dir.path());
   const OdometryConfig odometry_config;
 
@@ -287,12 +295,12 @@ TEST(GnssFusion, MappingThreadGivesTheInlineResultBitForBit) {
         mapper.addGnssFix(fixes[next_fix]);
     }
   };
-  Mapper inline_mapper(config, odometry_config, store);
+  Mapper inline_mapper(config, odometry_config, store, verifyLoop, gnss);
   run(inline_mapper);
   inline_mapper.finish();
   std::vector<std::vector<lie::SE3>> threaded_poses;
   for (int repeat = 0; repeat < 2; ++repeat) {
-    MappingThread thread(config, odometry_config, store);
+    MappingThread thread(config, odometry_config, store, {.gnss = gnss});
     run(thread);
     threaded_poses.push_back(thread.finish().graph().poses());
     ASSERT_TRUE(thread.finish().gnssReport()->T_enu_map.has_value());
@@ -345,9 +353,26 @@ TEST(GnssFusion, ConfigRejectsBadGnssFieldsByName) {
   config = MappingConfig{};
   config.gnss_min_fixes = 2;
   EXPECT_THROW(config.validate(), std::exception);
-  config = MappingConfig{};
-  config.gnss_correlation_time_s = -1.0;
-  EXPECT_THROW(config.validate(), std::exception);
+  GeorefConfig gnss;
+  gnss.error_correlation_time_s = -1.0;
+  EXPECT_THROW(gnss.validate(), std::exception);
+}
+
+TEST(GnssFusion, TakesTheAntennaLeverArmFromTheGeorefSection) {
+  // The antenna on a 1.5 m pole 0.5 m ahead of the body origin: with georef.p_body_antenna_m
+  // the map lands where it belongs; without, 1.5 m too high and the forward offset turns with
+  // the walk's heading.
+  const std::vector<lie::SE3> truth = trueRectangle();
+  const std::vector<lie::SE3> odometry = driftingOdometry(truth);
+  const FixNoise on_a_pole{.p_body_antenna_m = Eigen::Vector3d(0.5, 0.0, 1.5)};
+  const std::vector<GnssFix> fixes = fixesFor(truth, on_a_pole, 6);
+  GeorefConfig gnss = whiteGnss();
+  gnss.p_body_antenna_m = on_a_pole.p_body_antenna_m;
+  const Fused with = fuse(fusionConfig(), odometry, fixes, gnss);
+  const Fused without = fuse(fusionConfig(), odometry, fixes);
+  const lie::SE3 expected = trueEnuWorldAtFirstFix(fixes.front());
+  EXPECT_LT(georefRms(with, expected, truth), 0.2);
+  EXPECT_GT(georefRms(without, expected, truth), 1.4);
 }
 
 }  // namespace

@@ -67,6 +67,15 @@ class ConfigSection {
   virtual void validate() const {}
 };
 
+/// A key that moved to another place (full dotted paths): readers say where it went instead of
+/// calling it unknown.
+struct MovedConfigKey {
+  std::string_view old_key;
+  std::string_view new_key;
+  std::string_view why;
+};
+std::span<const MovedConfigKey> movedConfigKeys();
+
 /// Validates `root` and all its subsections; the thrown ConfigError's key is the full dotted path.
 void validateAll(ConfigSection& root);
 

@@ -1,6 +1,7 @@
 #pragma once
 // Configuration of the georeferencing at the end of taiga run and in taiga georef (issue 9,
-// thesis 3.4; docs/georeferencing.md).
+// thesis 3.4; docs/georeferencing.md), and of the GNSS receiver for mapping.gnss_fusion too:
+// one gate, one error correlation time, one lever arm.
 
 #include <Eigen/Core>
 #include <string>

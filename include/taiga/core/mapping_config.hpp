@@ -41,16 +41,12 @@ struct MappingConfig final : ConfigSection {
   double odometry_sigma_rad_per_m = 0.0005;
   // GNSS fixes as factors of the graph (issue 9, thesis Eq. 43; backend/gnss_factor.hpp), with
   // the map-to-ENU transform (yaw and translation) estimated alongside. Off by default: the
-  // thesis found that fusing poor under-canopy GNSS can break the map.
+  // thesis found that fusing poor under-canopy GNSS can break the map. The receiver's settings
+  // (gate, error correlation time, antenna lever arm) are the georef section's, one set for the
+  // fusion and the post-fit (GeorefConfig).
   bool gnss_fusion = false;
-  /// Fixes reporting a worse horizontal 1-sigma are not used (as georef --max-horizontal-sigma).
-  double gnss_max_horizontal_sigma_m = 5.0;
   /// Huber kernel threshold, in sigmas of the fix's reported covariance (multipath jumps).
   double gnss_huber_sigmas = 3.0;
-  /// Correlation time of the GNSS errors: each fix's cost is divided by the variance factor
-  /// (1 + rho) / (1 - rho), rho = exp(-dt / tau), of a mean of Gauss-Markov samples dt apart,
-  /// so slowly wandering errors do not count as independent. 0: white noise.
-  double gnss_correlation_time_s = 30.0;
   /// GNSS factors enter the graph only once this many fixes spread over this distance (the
   /// yaw of T_enu_map must be observable); T_enu_map starts from the robust post-fit.
   int gnss_min_fixes = 5;

@@ -3,12 +3,12 @@
 // turns geodetic fixes into GnssObservations of the PoseGraph.
 //
 // 1. Gate and convert (georef::prepareFixes, the post-fit's gating): fixes with no fix, invalid
-//    values or a reported horizontal sigma above gnss_max_horizontal_sigma_m are counted and
+//    values or a reported horizontal sigma above georef.max_horizontal_sigma_m are counted and
 //    dropped; the others go to local ENU at the first fix that passes.
 // 2. Attach by time: a fix waits until a keyframe at or after its time arrives; then the
 //    odometry pose at the fix time is interpolated on SE(3) between the two bracketing
 //    keyframes' odometry poses, and the fix is attached to the nearer of them with the antenna
-//    offset in that keyframe's body frame (d_body). The residual so depends on one keyframe only;
+//    (georef.p_body_antenna_m) in that keyframe's body frame (d_body). The residual so depends on one keyframe only;
 //    the odometry between two keyframes (< 1 m apart) is far better than GNSS. Interpolating in
 //    time assumes steady motion between keyframes. Fixes before the first keyframe or after the
 //    last are not used.
@@ -17,8 +17,9 @@
 //    becomes a factor; later fixes become factors as they are attached.
 // 4. Weights: each fix is whitened by its reported covariance under a Huber kernel at
 //    gnss_huber_sigmas, and its cost divided by the correlation factor
-//    f = (1 + rho) / (1 - rho), rho = exp(-dt / tau) (dt: time since the previous fix): a long
-//    mean of Gauss-Markov errors has f times the variance of a mean of white ones.
+//    f = (1 + rho) / (1 - rho), rho = exp(-dt / tau) (dt: time since the previous fix, tau
+//    georef.error_correlation_time_s): a long mean of Gauss-Markov errors has f times the
+//    variance of a mean of white ones.
 //
 // Everything is driven by the order of the calls (fixes and keyframes), not by wall time.
 
@@ -26,6 +27,7 @@
 #include <optional>
 #include <vector>
 
+#include "taiga/core/georef_config.hpp"
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/sensor_samples.hpp"
 #include "taiga/geo/coordinates.hpp"
@@ -50,7 +52,8 @@ struct GnssFusionReport {
 
 class GnssFusion {
  public:
-  explicit GnssFusion(const MappingConfig& config);
+  /// The receiver's gate, error correlation time and antenna from `gnss` (the georef section).
+  GnssFusion(const MappingConfig& config, const GeorefConfig& gnss);
 
   /// Gates the fix and queues it for attaching.
   void addFix(const GnssFix& fix);
@@ -73,6 +76,8 @@ class GnssFusion {
   void tryStart(PoseGraph& graph);
 
   MappingConfig config_;
+  double correlation_time_s_;        ///< of the GNSS errors (GeorefConfig)
+  Eigen::Vector3d p_body_antenna_m_;  ///< the antenna in the body frame (GeorefConfig)
   georef::FixGating gating_;
   geo::CoordinateConverter converter_;
   std::optional<geo::Geodetic> origin_;

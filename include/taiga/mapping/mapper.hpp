@@ -18,6 +18,7 @@
 #include <variant>
 #include <vector>
 
+#include "taiga/core/georef_config.hpp"
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/core/sensor_samples.hpp"
@@ -54,8 +55,9 @@ using LoopVerifier = std::function<LoopAttempt(
 class Mapper {
  public:
   /// Reads the keyframes' registration clouds from `store` (which must outlive the mapper).
+  /// `gnss`: the GNSS receiver's settings for config.gnss_fusion (the georef section).
   Mapper(const MappingConfig& config, const OdometryConfig& odometry, const KeyframeStore& store,
-         LoopVerifier verify_loop = verifyLoop);
+         LoopVerifier verify_loop = verifyLoop, const GeorefConfig& gnss = GeorefConfig{});
 
   /// Keyframe `id` of the store (ids in order, from 0) at its odometry pose, in the odometry's
   /// map segment `segment`. The graph's map frame starts as the odom frame at the first
@@ -129,6 +131,8 @@ struct MappingThreadOptions {
   /// Called on the mapping thread after every keyframe, with the graph as it is then (e.g. to
   /// rewrite the store's poses.tum, so that `taiga export-map` can export a running run's map).
   std::function<void(const Mapper&)> after_keyframe;
+  /// The GNSS receiver's settings for MappingConfig::gnss_fusion (the georef section).
+  GeorefConfig gnss;
 };
 
 /// A Mapper on its own thread. Messages are handled in order, so the result does not depend on
