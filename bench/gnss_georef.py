@@ -11,14 +11,17 @@ Errors against georef_truth.yaml:
 - horizontal: RMS over the trajectory's poses of the horizontal position error; heading: the yaw
   error; height: the up error.
 The expected error ("limit") is the Cramer-Rao bound of the simulator's own error model for the
-fixes the fit used (fixes.csv): true sigma = reported / reported_sigma_factor, a Gauss-Markov
-process with the simulator's correlation time, independent per axis; multipath left out. Its
-horizontal figure is the RMS over the poses of the propagated covariance, like the error.
+fixes the fit used (fixes.csv): each fix's true sigma (gnss_truth.csv), a Gauss-Markov process
+with the simulator's correlation time, independent per axis; multipath left out. It is the bound
+of an estimator that knows the true sigmas; with realism's noisy reported sigmas no estimator
+does. Its horizontal figure is the RMS over the poses of the propagated covariance, like the
+error. gnss_truth.csv also tells which fixes had multipath: how many the fit used, and how many
+clean ones it dropped.
 
 Usage: bench/gnss_georef.py OUT_DIR [SEEDS] [SCENARIO]
 Environment: TAIGAS (space-separated binaries, default build/bin/taiga; the first must write
-fixes.csv), DURATION (default: the
-scenario's), OVERRIDES (a YAML file of extra scenario fields, e.g. gnss: ...).
+fixes.csv and gnss_truth.csv), DURATION (default: the scenario's), REALISM (default ideal),
+OVERRIDES (a YAML file of extra scenario fields, e.g. gnss: ...).
 Example: bench/gnss_georef.py /tmp/gnss_bench "1 2 3 4 5 6 7 8 9 10" handheld-loop
 """
 import json, math, os, subprocess, sys
@@ -51,13 +54,13 @@ def gm_covariance(t, sigma, tau):
     return np.outer(sigma, sigma) * np.exp(-np.abs(t[:, None] - t[None, :]) / tau)
 
 
-def limit(fixes, yaw_true, gnss):
+def limit(fixes, truth, yaw_true, gnss):
     """Cramer-Rao bound over (t_e, t_n, yaw) and t_u under the simulator's error model."""
     used = fixes[fixes[:, 13] == 1]
     t = used[:, 0]
-    factor, tau = gnss["reported_sigma_factor"], gnss["correlation_time_s"]
-    s_h = np.sqrt(0.5 * (used[:, 4] ** 2 + used[:, 5] ** 2)) / factor
-    s_u = used[:, 6] / factor
+    tau = gnss["correlation_time_s"]
+    s_h = np.array([truth[round(x, 3)][4] for x in t])
+    s_u = np.array([truth[round(x, 3)][5] for x in t])
     Sinv_h = np.linalg.inv(gm_covariance(t, s_h, tau))
     Sinv_u = np.linalg.inv(gm_covariance(t, s_u, tau))
     c, s = math.cos(yaw_true), math.sin(yaw_true)
@@ -94,11 +97,13 @@ rows = []
 for seed in seeds:
     sim = f"{out}/{scenario}_{seed}"
     cmd = [taigas[0], "simulate", "--scenario", scenario, "--seed", seed, "--beams", "16", "--columns",
-           "512", "--sub-rays", "1", "--overrides", stride, "--out", sim]
+           "512", "--sub-rays", "1", "--overrides", stride, "--out", sim,
+           "--realism", os.environ.get("REALISM", "ideal")]
     if os.environ.get("DURATION"):
         cmd += ["--duration", os.environ["DURATION"]]
     run(cmd)
     truth = yaml.safe_load(open(f"{sim}/georef_truth.yaml"))
+    fix_truth = {round(r[0], 3): r for r in np.loadtxt(f"{sim}/gnss_truth.csv", delimiter=",", skiprows=1)}
     gnss = yaml.safe_load(open(f"{sim}/scenario.yaml"))["gnss"]
     gt = np.array([list(map(float, l.split())) for l in open(f"{sim}/groundtruth.tum")
                    if l.strip() and not l.startswith("#")])[::50]
@@ -129,10 +134,14 @@ for seed in seeds:
         # A binary without fixes.csv (before session 39) is judged by the first binary's fixes.
         fixes_csv = f"{est}/fixes.csv" if os.path.exists(f"{est}/fixes.csv") else f"{sim}/georef_0/fixes.csv"
         fixes = np.loadtxt(fixes_csv, delimiter=",", skiprows=1)
-        C, var_u = limit(fixes, yaw_true, gnss)
+        C, var_u = limit(fixes, fix_truth, yaw_true, gnss)
+        multipath = np.array([fix_truth[round(x, 3)][6] for x in fixes[:, 0]]) == 1
+        used = fixes[:, 13] == 1
         sig = g["sigma"]
         row = {"seed": int(seed), "binary": b, "used": g["fixes"]["used"],
                "outliers": g["fixes"]["outliers"],
+               "multipath_used": int(np.sum(multipath & used)),
+               "clean_dropped": int(np.sum(~multipath & ~used)),
                "err": [d[0], d[1], d[2], math.degrees(d_yaw)],
                "sigma": [sig["east_m"], sig["north_m"], sig["up_m"], sig["yaw_deg"]],
                "limit": [math.sqrt(C[0, 0]), math.sqrt(C[1, 1]), math.sqrt(var_u),
@@ -145,8 +154,9 @@ for seed in seeds:
 
 print(f"\n{scenario}, seeds {' '.join(seeds)}")
 print("| binary | horizontal RMS error / limit (m) | heading RMS / limit (deg) | height RMS / limit (m) "
-      "| ratio h, yaw, up | within 1 sigma (e, n, u, yaw) | within 2 sigma |")
-print("|---|---|---|---|---|---|---|")
+      "| ratio h, yaw, up | within 1 sigma (e, n, u, yaw) | within 2 sigma | multipath fixes used "
+      "| clean fixes dropped |")
+print("|---|---|---|---|---|---|---|---|---|")
 for b, taiga in enumerate(taigas):
     rs = [r for r in rows if r["binary"] == b]
     rms = lambda v: math.sqrt(sum(x * x for x in v) / len(v))
@@ -157,4 +167,5 @@ for b, taiga in enumerate(taigas):
     one = sum(v <= 1 for v in z) / len(z)
     two = sum(v <= 2 for v in z) / len(z)
     print(f"| {taiga} | {h:.2f} / {hl:.2f} | {y:.2f} / {yl:.2f} | {u:.2f} / {ul:.2f} | "
-          f"{h / hl:.2f}, {y / yl:.2f}, {u / ul:.2f} | {100 * one:.0f} % | {100 * two:.0f} % |")
+          f"{h / hl:.2f}, {y / yl:.2f}, {u / ul:.2f} | {100 * one:.0f} % | {100 * two:.0f} % | "
+          f"{sum(r['multipath_used'] for r in rs)} | {sum(r['clean_dropped'] for r in rs)} |")

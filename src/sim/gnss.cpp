@@ -105,8 +105,14 @@ std::optional<GnssFix> GnssSimulator::next(const WalkingMotion& motion, const Sc
       jump_m_.setZero();
     }
     error += jump_m_;
-    if (hashUniform(seed_, k, 8) < params_.outage_probability * cover) return std::nullopt;
   }
+  truth_ = {.t_s = t + time_offset_s,
+            .sigma_horizontal_m = sigma_h,
+            .sigma_vertical_m = sigma_v,
+            .error_enu_m = error,
+            .multipath = !jump_m_.isZero(),
+            .outage = params_.noise && hashUniform(seed_, k, 8) < params_.outage_probability * cover};
+  if (truth_.outage) return std::nullopt;
   Eigen::Vector3d p_enu = p_world;
   if (params_.world_yaw_deg != 0.0) {  // world x is world_yaw_deg counterclockwise from east
     const double yaw = params_.world_yaw_deg * kRadPerDeg;
@@ -119,8 +125,12 @@ std::optional<GnssFix> GnssSimulator::next(const WalkingMotion& motion, const Sc
   fix.latitude_deg = g.latitude_deg;
   fix.longitude_deg = g.longitude_deg;
   fix.height_ellipsoid_m = g.height_m;
-  const double reported_h = params_.reported_sigma_factor * sigma_h,
-               reported_v = params_.reported_sigma_factor * sigma_v;
+  const double report_error =
+      params_.noise && params_.reported_sigma_noise > 0.0
+          ? std::exp(params_.reported_sigma_noise * hashNormal(seed_, k, 9, 0))
+          : 1.0;
+  const double reported_h = params_.reported_sigma_factor * report_error * sigma_h,
+               reported_v = params_.reported_sigma_factor * report_error * sigma_v;
   fix.covariance_enu_m2 =
       Eigen::Vector3d(reported_h * reported_h, reported_h * reported_h, reported_v * reported_v)
           .asDiagonal();

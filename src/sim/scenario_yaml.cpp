@@ -244,6 +244,7 @@ const Field<GnssParams> kGnssFields[] = {
     {"multipath_jump_m", &GnssParams::multipath_jump_m, "typical jump, m", 0, 1000},
     {"outage_probability", &GnssParams::outage_probability, "per fix under full canopy", 0, 1},
     {"reported_sigma_factor", &GnssParams::reported_sigma_factor, "reported / true sigma", 0.01, 100},
+    {"reported_sigma_noise", &GnssParams::reported_sigma_noise, "log-normal spread of the reported sigma per fix", 0, 2},
     {"noise", &GnssParams::noise, "false: exact positions, no outages"},
 };
 

@@ -4,6 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
+
+#include <fmt/os.h>
 
 #include "machine_boxes_output.hpp"
 #include "outputs.hpp"
@@ -166,6 +169,14 @@ SimulationSummary writeSimulation(const Simulation& simulation,
                                                          scenario.output.pcap_profile,
                                                          simulation.seed()));
   Trajectory ground_truth;
+  // Each fix's true error and sigma (docs/simulator.md), for benchmarks of the georeferencing.
+  std::optional<fmt::ostream> gnss_truth;
+  if (scenario.output.gnss) {
+    gnss_truth.emplace(fmt::output_file((out_dir / "gnss_truth.csv").string()));
+    gnss_truth->print(
+        "t_s,error_east_m,error_north_m,error_up_m,sigma_horizontal_m,sigma_vertical_m,multipath,"
+        "outage\n");
+  }
   auto emitUntil = [&](double t_end_s) {
     while (imu.nextTime_s() <= t_end_s) {
       const double t = imu.nextTime_s();
@@ -181,8 +192,13 @@ SimulationSummary writeSimulation(const Simulation& simulation,
       ground_truth.append(t + kRecordingEpoch_s, motion.at(t).T_world_body);
     }
     while (gnss.nextTime_s() <= t_end_s) {
-      if (const auto fix = gnss.next(motion, scene, kRecordingEpoch_s)) {
-        if (!scenario.output.gnss) continue;
+      const auto fix = gnss.next(motion, scene, kRecordingEpoch_s);
+      if (!scenario.output.gnss) continue;
+      const GnssSimulator::Truth& truth = gnss.lastTruth();
+      gnss_truth->print("{},{},{},{},{},{},{},{}\n", truth.t_s, truth.error_enu_m.x(),
+                        truth.error_enu_m.y(), truth.error_enu_m.z(), truth.sigma_horizontal_m,
+                        truth.sigma_vertical_m, truth.multipath ? 1 : 0, truth.outage ? 1 : 0);
+      if (fix) {
         bag.writeGnss(kGnssTopic, "gnss", *fix);
         ++summary.gnss_fixes;
       }

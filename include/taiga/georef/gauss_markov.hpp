@@ -30,7 +30,7 @@ namespace taiga::georef {
 /// What the fit found out about the error model (georef.yaml's `error_model`).
 struct GnssErrorModel {
   double configured_correlation_time_s = 0.0;
-  double correlation_time_s = 0.0;  ///< tau chosen (0: white noise only)
+  double correlation_time_s = 0.0;  ///< tau chosen: the configured one or 3x (0: white noise)
   /// Variance of the white part, in units of the Gauss-Markov part's (q above).
   double white_share = 0.0;
   /// How far the reported sigmas' swings are believed: the model's sigma of fix k is
@@ -76,8 +76,8 @@ struct GaussMarkovOptions {
 
 /// The fixes with use[i] (at least 3 at distinct times, else InputError) are taken in time
 /// order; a fix at the same time as the previous one is skipped. For each candidate model
-/// (correlation time tau / 3, tau or 3 tau, or white noise when tau is 0; white share; sigma
-/// trust; or only options.model), Gauss-Newton from (start_yaw_rad, start_t) over
+/// (correlation time tau or 3 tau, or white noise when tau is 0; white share; sigma trust; or
+/// only options.model), Gauss-Newton from (start_yaw_rad, start_t) over
 /// (t_east, t_north, yaw) and the height offset in closed form; the most likely is returned.
 /// Then fixes whose whitened residual exceeds outlier_sigmas robust sigmas (multipath that
 /// plain residuals hide) are dropped one at a time, at most a fifth of them.

@@ -42,6 +42,15 @@ class GnssSimulator {
   /// The next fix (or nothing during an outage); time is motion time + time_offset_s.
   std::optional<GnssFix> next(const WalkingMotion& motion, const Scene& scene,
                               double time_offset_s = 0.0);
+  /// What the last fix drawn by next() really was (also for an outage).
+  struct Truth {
+    double t_s = 0.0;  ///< as the fix's stamp
+    double sigma_horizontal_m = 0.0, sigma_vertical_m = 0.0;  ///< true 1-sigma
+    Eigen::Vector3d error_enu_m = Eigen::Vector3d::Zero();     ///< multipath included
+    bool multipath = false;
+    bool outage = false;
+  };
+  const Truth& lastTruth() const { return truth_; }
   /// Canopy cover above a point, in [0, 1].
   static double canopyCover(const Scene& scene, const Eigen::Vector3d& p_world);
   Geodetic origin() const {
@@ -55,6 +64,7 @@ class GnssSimulator {
   Eigen::Vector3d markov_ = Eigen::Vector3d::Zero();  ///< unit-variance Gauss-Markov state
   Eigen::Vector3d jump_m_ = Eigen::Vector3d::Zero();
   int jump_fixes_left_ = 0;
+  Truth truth_;
 };
 
 }  // namespace taiga::sim

@@ -175,6 +175,9 @@ struct GnssParams {
   double multipath_jump_m = 15.0;          ///< typical size of a jump, m
   double outage_probability = 0.08;        ///< per fix under full canopy: no fix
   double reported_sigma_factor = 0.7;      ///< reported / true sigma (< 1: optimistic receiver)
+  /// The reported sigma is further off by a factor exp(N(0, s^2)) per fix, s this value: a
+  /// receiver's sigma is an estimate too, only loosely tied to the error it describes.
+  double reported_sigma_noise = 0.0;
   bool noise = true;
 };
 
