@@ -132,7 +132,8 @@ for seed in seeds:
         err = np.stack([ce * xy[:, 0] - se * xy[:, 1] - (ct * xy[:, 0] - st * xy[:, 1]) + d[0],
                         se * xy[:, 0] + ce * xy[:, 1] - (st * xy[:, 0] + ct * xy[:, 1]) + d[1]], axis=1)
         # A binary without fixes.csv (before session 39) is judged by the first binary's fixes.
-        fixes_csv = f"{est}/fixes.csv" if os.path.exists(f"{est}/fixes.csv") else f"{sim}/georef_0/fixes.csv"
+        own_fixes = os.path.exists(f"{est}/fixes.csv")
+        fixes_csv = f"{est}/fixes.csv" if own_fixes else f"{sim}/georef_0/fixes.csv"
         fixes = np.loadtxt(fixes_csv, delimiter=",", skiprows=1)
         C, var_u = limit(fixes, fix_truth, yaw_true, gnss)
         multipath = np.array([fix_truth[round(x, 3)][6] for x in fixes[:, 0]]) == 1
@@ -140,8 +141,8 @@ for seed in seeds:
         sig = g["sigma"]
         row = {"seed": int(seed), "binary": b, "used": g["fixes"]["used"],
                "outliers": g["fixes"]["outliers"],
-               "multipath_used": int(np.sum(multipath & used)),
-               "clean_dropped": int(np.sum(~multipath & ~used)),
+               "multipath_used": int(np.sum(multipath & used)) if own_fixes else None,
+               "clean_dropped": int(np.sum(~multipath & ~used)) if own_fixes else None,
                "err": [d[0], d[1], d[2], math.degrees(d_yaw)],
                "sigma": [sig["east_m"], sig["north_m"], sig["up_m"], sig["yaw_deg"]],
                "limit": [math.sqrt(C[0, 0]), math.sqrt(C[1, 1]), math.sqrt(var_u),
@@ -157,6 +158,7 @@ print("| binary | horizontal RMS error / limit (m) | heading RMS / limit (deg) |
       "| ratio h, yaw, up | within 1 sigma (e, n, u, yaw) | within 2 sigma | multipath fixes used "
       "| clean fixes dropped |")
 print("|---|---|---|---|---|---|---|---|---|")
+count = lambda key, rs: "n/a" if rs[0][key] is None else sum(r[key] for r in rs)
 for b, taiga in enumerate(taigas):
     rs = [r for r in rows if r["binary"] == b]
     rms = lambda v: math.sqrt(sum(x * x for x in v) / len(v))
@@ -168,4 +170,4 @@ for b, taiga in enumerate(taigas):
     two = sum(v <= 2 for v in z) / len(z)
     print(f"| {taiga} | {h:.2f} / {hl:.2f} | {y:.2f} / {yl:.2f} | {u:.2f} / {ul:.2f} | "
           f"{h / hl:.2f}, {y / yl:.2f}, {u / ul:.2f} | {100 * one:.0f} % | {100 * two:.0f} % | "
-          f"{sum(r['multipath_used'] for r in rs)} | {sum(r['clean_dropped'] for r in rs)} |")
+          f"{count('multipath_used', rs)} | {count('clean_dropped', rs)} |")
