@@ -6,11 +6,11 @@
 // process plus white noise:
 //   e_k / s_k = m(t_k) + v_k,   E[m(t) m(t')] = exp(-|t - t'| / tau),   v_k ~ N(0, q).
 // m is the slowly drifting error under canopy (multipath, satellites coming and going), v what
-// changes from fix to fix. A scalar Kalman filter over m gives the
-// innovations, independent with known variance; dividing each by its standard deviation
-// whitens the residuals and, applied to the Jacobian's columns too, turns least squares into
-// generalized least squares (the best linear unbiased estimate under the model), whose normal
-// matrix is the model's information (the inverse of the Cramer-Rao bound of the linearized fit).
+// changes from fix to fix. A scalar Kalman filter over m gives the innovations, independent with
+// known variance; dividing each by its standard deviation whitens the residuals and, applied to
+// the Jacobian's columns too, turns least squares into generalized least squares (the best
+// linear unbiased estimate under the model), whose normal matrix is the model's information (the
+// inverse of the Cramer-Rao bound of the linearized fit).
 // The whitened residuals' spread is then the honest scale of the reported sigmas, which plain
 // residuals hide when the errors drift slowly.
 //

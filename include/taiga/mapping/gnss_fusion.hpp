@@ -8,10 +8,10 @@
 // 2. Attach by time: a fix waits until a keyframe at or after its time arrives; then the
 //    odometry pose at the fix time is interpolated on SE(3) between the two bracketing
 //    keyframes' odometry poses, and the fix is attached to the nearer of them with the antenna
-//    (georef.p_body_antenna_m) in that keyframe's body frame (d_body). The residual so depends on one keyframe only;
-//    the odometry between two keyframes (< 1 m apart) is far better than GNSS. Interpolating in
-//    time assumes steady motion between keyframes. Fixes before the first keyframe or after the
-//    last are not used.
+//    (georef.p_body_antenna_m) in that keyframe's body frame (d_body). The residual so depends
+//    on one keyframe only; the odometry between two keyframes (< 1 m apart) is far better than
+//    GNSS. Interpolating in time assumes steady motion between keyframes. Fixes before the
+//    first keyframe or after the last are not used.
 // 3. Start: once gnss_min_fixes fixes are attached and the track spans gnss_min_spread_m
 //    horizontally, T_enu_map starts from georef::fitRobust on them and every attached fix
 //    becomes a factor; later fixes become factors as they are attached.
