@@ -165,7 +165,9 @@ int runAlsGeoref(const AlsGeorefOptions& options) {
   const Eigen::Vector3d start = guess.T_grid_map.translation();
   const double scale = converter.gridTangent(converter.fromProjected(start)).scale;
   const Eigen::DiagonalMatrix<double, 3> S(scale, scale, 1.0);
-  std::vector<Eigen::Vector3d> map_points = io::readAnyCloudFile(run / "map.las").positions;
+  // Read once: registered in grid metres, then written in the grid.
+  PointCloud map = io::readAnyCloudFile(run / "map.las");
+  std::vector<Eigen::Vector3d>& map_points = map.positions;
   if (map_points.empty())
     throw InputError(fmt::format("{}: no points", (run / "map.las").string()));
   for (Eigen::Vector3d& p : map_points) p = S * p;
@@ -225,8 +227,7 @@ int runAlsGeoref(const AlsGeorefOptions& options) {
   const fs::path out = options.out;
   georef::writeGridCsv(out / fmt::format("trajectory_epsg{}.csv", guess.epsg), poses);
   georef::writeGeoJson(out / "trajectory.geojson", poses, guess.epsg, "trajectory (ALS)");
-  PointCloud map = io::readAnyCloudFile(run / "map.las");
-  for (Eigen::Vector3d& p : map.positions) p = r.T_grid_map * (S * p);
+  for (Eigen::Vector3d& p : map_points) p = r.T_grid_map * p;  // already scaled by S
   io::LasWriter writer(out / fmt::format("map_epsg{}.las", guess.epsg), {.wkt = converter.wkt()});
   writer.append(map);
   writer.close();

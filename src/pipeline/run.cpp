@@ -291,6 +291,7 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     summary.streams->foxglove_clients = f.connections;
     summary.streams->foxglove_messages = f.messages_sent;
     summary.streams->foxglove_dropped = f.messages_dropped;
+    summary.streams->foxglove_history_dropped = f.history_dropped;
   }
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();

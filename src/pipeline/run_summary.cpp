@@ -154,7 +154,8 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
     j["streams"] = {{"poses_sent", s.streams->poses_sent},
                     {"foxglove_clients", s.streams->foxglove_clients},
                     {"foxglove_messages", s.streams->foxglove_messages},
-                    {"foxglove_dropped", s.streams->foxglove_dropped}};
+                    {"foxglove_dropped", s.streams->foxglove_dropped},
+                    {"foxglove_history_dropped", s.streams->foxglove_history_dropped}};
   if (s.live) {
     const io::ouster::LiveStats& l = *s.live;
     j["live"] = {{"lidar_packets", l.lidar_packets},

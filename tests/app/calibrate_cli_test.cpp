@@ -1,6 +1,6 @@
 // Issue 20: `taiga calibrate` as users run it, on a simulated handheld walk whose rig.yaml is off
 // by 2 deg and 10 ms (`typical` realism): the offset is found to within a millisecond, the
-// rotation about every axis, and the corrected rig.yaml is a valid configuration; a 90 deg
+// rotation about every axis, and the corrected rig.yaml is a valid configuration; a 90 or 180 deg
 // mounting error is found too. Bad input gets a clear error.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -64,26 +64,30 @@ TEST(CalibrateCli, FindsTheTimeOffsetAndRotationOfATypicalRig) {
   suggested << "gyro_noise_density: " << noise["suggested_radps_sqrthz"].get<double>();
   EXPECT_THAT(config.output, HasSubstr(suggested.str()));
 
-  // A lidar mounted 90 deg from what the rig says (the truth is the identity): the IMU's
-  // prediction cannot start the registrations, and a lidar-only pass finds the mounting first.
+  // A lidar mounted 90 deg about z, or upside down (180 deg about x), from what the rig says (the
+  // truth is the identity): the IMU's prediction cannot start the registrations, and a
+  // lidar-only pass finds the mounting first.
   std::ifstream in(sim / "rig.yaml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::size_t at = text.find("quaternion_xyzw: [");
+  const std::string rig((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = rig.find("quaternion_xyzw: [");
   ASSERT_NE(at, std::string::npos);
-  text.replace(at, text.find(']', at) + 1 - at,
-               "quaternion_xyzw: [0, 0, 0.7071067811865476, 0.7071067811865476]");
-  std::ofstream(dir.file("rig_90.yaml")) << text;
-  const auto out_90 = dir.file("calibrated_90");
-  const test::TaigaResult r90 =
-      test::runTaiga("calibrate " + (sim / "recording.bag").string() + " --config " +
-                     dir.file("rig_90.yaml").string() + " --out " + out_90.string());
-  ASSERT_EQ(r90.exit_code, 0) << r90.output;
-  const nlohmann::json j90 = nlohmann::json::parse(std::ifstream(out_90 / "calibration.json"));
-  EXPECT_EQ(j90["passes"][1]["odometry"], "lidar-only");
-  const std::vector<double> q = j90["rotation"]["estimated_quaternion_xyzw"];
-  const double angle_deg = 2.0 * std::acos(std::min(1.0, std::abs(q[3]))) * 180.0 / M_PI;
-  EXPECT_LT(angle_deg, 1.5);  // from 90 deg; the gyro's misalignment floor is about 0.5
-  EXPECT_NEAR(j90["time_offset"]["estimated_s"].get<double>(), 0.010, 0.001);
+  for (const std::string mounting : {"0, 0, 0.7071067811865476, 0.7071067811865476", "1, 0, 0, 0"}) {
+    std::string text = rig;
+    text.replace(at, text.find(']', at) + 1 - at, "quaternion_xyzw: [" + mounting + "]");
+    std::ofstream(dir.file("rig_wrong.yaml")) << text;
+    const auto out_wrong = dir.file("calibrated_wrong");
+    const test::TaigaResult wrong =
+        test::runTaiga("calibrate " + (sim / "recording.bag").string() + " --config " +
+                       dir.file("rig_wrong.yaml").string() + " --out " + out_wrong.string());
+    ASSERT_EQ(wrong.exit_code, 0) << mounting << wrong.output;
+    const nlohmann::json j_wrong =
+        nlohmann::json::parse(std::ifstream(out_wrong / "calibration.json"));
+    EXPECT_EQ(j_wrong["passes"][1]["odometry"], "lidar-only") << mounting;
+    const std::vector<double> q = j_wrong["rotation"]["estimated_quaternion_xyzw"];
+    const double angle_deg = 2.0 * std::acos(std::min(1.0, std::abs(q[3]))) * 180.0 / M_PI;
+    EXPECT_LT(angle_deg, 1.5) << mounting;  // the gyro's misalignment floor is about 0.5
+    EXPECT_NEAR(j_wrong["time_offset"]["estimated_s"].get<double>(), 0.010, 0.001) << mounting;
+  }
 }
 
 TEST(CalibrateCli, ARecordingWithoutAnImuIsBadInput) {

@@ -348,6 +348,13 @@ TEST(LiveCli, AFoxgloveClientThatJoinsLateGetsTheMapGraphLoopsGeoreferenceAndTre
   EXPECT_EQ(grid.back()["epsg"], 3067);
   EXPECT_NEAR(grid.back()["t_s"].get<double>(), std::stod(t_field), 1e-5);
   EXPECT_NEAR(grid.back()["easting_m"].get<double>(), std::stod(easting_field), 1e-3);
+
+  // The server's account in summary.json: one client, messages sent, nothing dropped from the
+  // history a late client receives (30 s of a walk is well within its budget).
+  const nlohmann::json streams = nlohmann::json::parse(readText(out / "summary.json"))["streams"];
+  EXPECT_EQ(streams["foxglove_clients"], 1);
+  EXPECT_GT(streams["foxglove_messages"].get<int>(), 100);
+  EXPECT_EQ(streams["foxglove_history_dropped"], 0);
 }
 
 // The packets of one sensor configuration, and metadata that describes another profile or

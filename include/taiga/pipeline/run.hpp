@@ -165,10 +165,12 @@ struct RunSummary {
   std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
   std::optional<io::ouster::LiveStats> live;        ///< taiga run --live: the packets' fate
   /// live.pose_udp / live.foxglove: poses sent; Foxglove clients and messages (and those dropped
-  /// for a client too far behind).
+  /// for a client too far behind, and kept messages dropped from the history that late clients
+  /// receive).
   struct Streams {
     std::size_t poses_sent = 0;
-    std::uint64_t foxglove_clients = 0, foxglove_messages = 0, foxglove_dropped = 0;
+    std::uint64_t foxglove_clients = 0, foxglove_messages = 0, foxglove_dropped = 0,
+                  foxglove_history_dropped = 0;
   };
   std::optional<Streams> streams;
   /// With mapping.trees: the stems in trees.csv, the worker's busy time on the live list during
