@@ -3,10 +3,12 @@
 // grid with the registration's report.
 #include "georef_als.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 #include <fmt/os.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -71,7 +73,14 @@ Guess startingPose(const AlsGeorefOptions& options) {
     guess.T_grid_map = lie::SE3(lie::SO3(Eigen::Quaterniond(R).normalized()),
                                 grid.T_epsg_world.topRightCorner<3, 1>());
     guess.epsg = grid.epsg;
-    guess.search_m = guess.search_deg = 8.0;
+    // Wide enough for the GNSS fit's uncertainty: 4 sigma, at least 3 m and 3 deg (the search's
+    // own steps and a margin for a sigma that is a little optimistic), at most 25 (as without
+    // GNSS); 8 m and 8 deg for a georef.yaml without a sigma.
+    guess.search_m = grid.sigma_horizontal_m
+                         ? std::clamp(4.0 * *grid.sigma_horizontal_m, 3.0, 25.0)
+                         : 8.0;
+    guess.search_deg =
+        grid.sigma_yaw_deg ? std::clamp(4.0 * *grid.sigma_yaw_deg, 3.0, 25.0) : 8.0;
     guess.source = yaml.string();
   }
   if (options.epsg) guess.epsg = *options.epsg;
@@ -207,9 +216,10 @@ int runAlsGeoref(const AlsGeorefOptions& options) {
       (r.T_grid_map.rotation() * guess.T_grid_map.rotation().inverse()).Log().z() * kDegPerRad;
   fmt::print(
       "registered coverage {:.0f} %, score {:.3f} (next {:.3f}); the map moved {:.2f} m "
-      "horizontally, {:.2f} m in height and turned {:.2f} deg from the start ({})\n",
+      "horizontally, {:.2f} m in height and turned {:.2f} deg from the start ({}, searched "
+      "{:.1f} m and {:.1f} deg around it)\n",
       100.0 * r.coverage, r.score, r.second_score, moved.head<2>().norm(), moved.z(), turned_deg,
-      guess.source);
+      guess.source, guess.search_m, guess.search_deg);
   fmt::print(
       "1-sigma    east {:.3f} m, north {:.3f} m, up {:.3f} m, roll {:.3f} deg, pitch {:.3f} "
       "deg, yaw {:.3f} deg\n",

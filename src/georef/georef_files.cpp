@@ -256,6 +256,20 @@ GeorefGrid readGeorefGrid(const std::filesystem::path& path) {
   }
   if (!grid.T_epsg_world.allFinite())
     throw InputError(fmt::format("{}: T_epsg_world has non-finite values", path.string()));
+  // The 1-sigma is optional (georef.yaml files before it had one, or written by hand).
+  try {
+    if (const YAML::Node sigma = root["sigma"]; sigma && sigma.IsMap()) {
+      const double east = sigma["east_m"].as<double>(), north = sigma["north_m"].as<double>(),
+                   yaw = sigma["yaw_deg"].as<double>();
+      if (std::isfinite(east) && std::isfinite(north) && std::isfinite(yaw)) {
+        grid.sigma_horizontal_m = std::hypot(east, north);
+        grid.sigma_yaw_deg = yaw;
+      }
+    }
+  } catch (const YAML::Exception& e) {
+    throw InputError(fmt::format("{}: sigma: expected east_m, north_m and yaw_deg: {}",
+                                 path.string(), e.what()));
+  }
   return grid;
 }
 

@@ -109,6 +109,12 @@ TEST(GeorefYaml, HoldsTheTransformsSigmasAndCountsAtFullPrecision) {
   EXPECT_EQ(yaml["fixes"]["gated_sigma"].as<int>(), 8);
   EXPECT_EQ(yaml["fixes"]["used"].as<int>(), 40);
   EXPECT_EQ(yaml["fixes"]["outliers"].as<int>(), 2);
+  // What `taiga georef --als` reads back: the grid and the 1-sigma that sets its search.
+  const GeorefGrid grid = readGeorefGrid(dir.file("georef.yaml"));
+  EXPECT_EQ(grid.T_epsg_world(0, 3), 364808.14192166715);
+  ASSERT_TRUE(grid.sigma_horizontal_m && grid.sigma_yaw_deg);
+  EXPECT_NEAR(*grid.sigma_horizontal_m, std::hypot(0.1, 0.2), 1e-15);
+  EXPECT_NEAR(*grid.sigma_yaw_deg, 0.003 * kDegPerRad, 1e-12);
 }
 
 TEST(GeorefYaml, QuotedNamesAndNonFiniteSigmasReadBack) {
@@ -127,6 +133,7 @@ TEST(GeorefYaml, QuotedNamesAndNonFiniteSigmasReadBack) {
   EXPECT_TRUE(std::isnan(yaml["sigma"]["yaw_deg"].as<double>()));
   EXPECT_EQ(yaml["sigma"]["up_m"].as<double>(), std::numeric_limits<double>::infinity());
   EXPECT_FALSE(yaml["converged"].as<bool>());
+  EXPECT_FALSE(readGeorefGrid(dir.file("georef.yaml")).sigma_yaw_deg);  // not finite: none
 }
 
 TEST(GeoJson, IsALineStringInTheNamedCrsAtFullPrecision) {

@@ -3,6 +3,7 @@
 // code (fit.hpp) does no I/O; these functions do only I/O and formatting.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,12 +56,16 @@ void writeGeorefYaml(const std::filesystem::path& path, const GeorefReport& repo
 void writeFixesCsv(const std::filesystem::path& path, const std::vector<AssociatedFix>& fixes,
                    const GeorefFit& fit);
 
-/// The grid a georef.yaml places the world (map) frame in: its EPSG code and T_epsg_world.
+/// The grid a georef.yaml places the world (map) frame in: its EPSG code and T_epsg_world, and
+/// the fit's 1-sigma when the file has them.
 struct GeorefGrid {
   int epsg = 0;
   Eigen::Matrix4d T_epsg_world = Eigen::Matrix4d::Identity();
+  std::optional<double> sigma_horizontal_m;  ///< hypot of sigma.east_m and sigma.north_m
+  std::optional<double> sigma_yaw_deg;
 };
-/// Reads `epsg` and `T_epsg_world` of a georef.yaml; InputError naming the file and the key.
+/// Reads `epsg`, `T_epsg_world` and `sigma` of a georef.yaml; InputError naming the file and the
+/// key.
 GeorefGrid readGeorefGrid(const std::filesystem::path& path);
 
 }  // namespace taiga::georef
