@@ -66,8 +66,12 @@ def georef(sim, run, dest, T_true, shift_m, turn_deg, search, seed):
            f"{e:.3f},{n:.3f},{yaw:.3f}", "--search-m", str(search), "--search-deg", str(search),
            "--out", dest]
     start_s = time.monotonic()
-    subprocess.run(cmd, capture_output=True, text=True)
+    done = subprocess.run(cmd, capture_output=True, text=True)
     seconds = time.monotonic() - start_s
+    if not os.path.exists(f"{dest}/georef_als.yaml"):  # refused before registering (exit 2)
+        lines = (done.stderr or done.stdout).strip().splitlines()
+        return {"ok": False, "reason": lines[-1] if lines else f"exit {done.returncode}",
+                "seconds": round(seconds, 1)}
     report = yaml.safe_load(open(f"{dest}/georef_als.yaml"))
     result = {"ok": report["ok"], "reason": report.get("reason", ""), "seconds": round(seconds, 1),
               "map_points_used": report["map_points"], "als_points": report["als_points"]}
