@@ -37,22 +37,39 @@ def yaw_of(q):  # x y z w
     return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
+def rotation(q):  # x y z w
+    x, y, z, w = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
 def true_grid_pose(sim, run):
-    """T_grid_map of the run's map frame: the truth's T_epsg_world times T_world_map (Kabsch)."""
+    """T_grid_map of the run's map frame: the truth's T_epsg_world times T_world_map. The rotation
+    from the orientations (the chordal mean of R_world_body(t) R_map_body(t)^T over the run's
+    poses), not from the positions: a harvester's nearly straight track does not fix the heading
+    (a Kabsch fit of its positions was off by tenths of a degree); the translation then from the
+    positions."""
     truth = yaml.safe_load(open(f"{sim}/georef_truth.yaml"))
     T_gw = np.array(truth["T_epsg_world"])
     _, gt_rows = tum(f"{sim}/groundtruth.tum")
     _, est_rows = tum(f"{run}/trajectory.tum")
-    gt_t = np.array([r[0] for r in gt_rows]); gt_p = np.array([r[1:4] for r in gt_rows])
-    # The truth's positions interpolated at the run's times (which need not fall on its samples).
-    pairs = [(np.array(r[1:4]), np.array([np.interp(r[0], gt_t, gt_p[:, k]) for k in range(3)]))
-             for r in est_rows if gt_t[0] <= r[0] <= gt_t[-1]]
-    A = np.array([p[0] for p in pairs]); B = np.array([p[1] for p in pairs])
-    ca, cb = A.mean(0), B.mean(0)
-    U, _, Vt = np.linalg.svd((A - ca).T @ (B - cb))
-    D = np.diag([1, 1, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    T_wm = np.eye(4); T_wm[:3, :3] = R; T_wm[:3, 3] = cb - R @ ca
+    gt_t = np.array([r[0] for r in gt_rows])
+    gt = np.array([r[1:8] for r in gt_rows])
+    A, B, M = [], [], np.zeros((3, 3))
+    for r in est_rows:
+        if not gt_t[0] <= r[0] <= gt_t[-1]:
+            continue
+        i = min(max(int(np.searchsorted(gt_t, r[0])), 1), len(gt_t) - 1)
+        f = (r[0] - gt_t[i - 1]) / (gt_t[i] - gt_t[i - 1])
+        A.append(np.array(r[1:4]))
+        B.append(gt[i - 1, :3] + f * (gt[i, :3] - gt[i - 1, :3]))
+        nearest = i if f > 0.5 else i - 1  # 200 Hz truth: within 2.5 ms of the pose
+        M += rotation(gt[nearest, 3:7]) @ rotation(r[4:8]).T
+    U, _, Vt = np.linalg.svd(M)
+    R = U @ np.diag([1, 1, np.sign(np.linalg.det(U @ Vt))]) @ Vt
+    A, B = np.array(A), np.array(B)
+    T_wm = np.eye(4); T_wm[:3, :3] = R; T_wm[:3, 3] = (B - A @ R.T).mean(0)
     return T_gw @ T_wm
 
 
