@@ -3,7 +3,6 @@
 // grid with the registration's report.
 #include "georef_als.hpp"
 
-#include <algorithm>
 #include <fmt/format.h>
 #include <fmt/os.h>
 

@@ -39,8 +39,8 @@ void OnlineGeoreferencer::associatePending() {
   if (association.pairs.empty()) return;
   associated_.insert(associated_.end(), association.pairs.begin(), association.pairs.end());
   // The error model is chosen again whenever the fixes have grown by a quarter since the last
-  // choice (a choice tries a hundred models; an hour of 1 Hz fixes refitted with all of them at
-  // every fix would cost minutes), and kept in between.
+  // choice (a choice tries about ninety models; an hour of 1 Hz fixes refitted with all of them
+  // at every fix would cost minutes), and kept in between.
   FitOptions options = settings_.fit;
   const bool choose = !model_ || 4 * associated_.size() >= 5 * model_fixes_;
   if (!choose) options.error_model = model_;

@@ -17,9 +17,9 @@
 //    points' errors are correlated over metres, so the GICP Hessian's formal covariance would be
 //    ten times too small).
 // 5. Checks: the share of the map's points with an ALS point within 1 m (coverage, at least
-//    0.7), and the best
-//    candidate more than 4 m or 4 deg from the best one against it (ambiguity). A map the ALS does
-//    not cover, or an ambiguous search, is a failure with its reason, never a pose.
+//    0.7), and the best candidate more than 4 m or 4 deg from the best one against it
+//    (ambiguity). A map the ALS does not cover, or an ambiguous search, is a failure with its
+//    reason, never a pose.
 
 #include <Eigen/Core>
 #include <span>
