@@ -114,8 +114,10 @@ TEST(ViewCli, TheViewerFollowsALiveRun) {
     return checkPage("http://" + address + "/", dir.file("live.png"));
   });
   std::this_thread::sleep_for(std::chrono::seconds(1));  // until it listens
-  const test::TaigaResult replay = test::runTaiga(
-      fmt::format("replay {} --rate 1 --port-offset {}", (sim / "capture.pcap").string(), offset));
+  // The viewer serves once the first scans arrived, and Chromium may take seconds to start on a
+  // loaded machine: the 4 s capture at a quarter of its pace leaves the page 16 s to connect.
+  const test::TaigaResult replay = test::runTaiga(fmt::format(
+      "replay {} --rate 0.25 --port-offset {}", (sim / "capture.pcap").string(), offset));
   ASSERT_EQ(replay.exit_code, 0) << replay.output;
   const test::TaigaResult run = live.get();
   ASSERT_EQ(run.exit_code, 0) << run.output;
