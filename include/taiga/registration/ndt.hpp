@@ -5,7 +5,9 @@
 // between compact 3D NDT representations" (IJRR 2012).
 //
 // Target: voxel cells with the mean and covariance of their points; a covariance's eigenvalues
-// are clamped from below to min_eigenvalue_ratio times the largest (Magnusson 6.2). Each source
+// are clamped from below to min_eigenvalue_ratio times the largest (Magnusson 6.2); a cell whose
+// points lie along a line (its middle eigenvalue below line_cell_ratio times the largest) is not
+// used (docs/registration.md, "Line cells"). Each source
 // point x' = T x contributes the normal-plus-uniform mixture score
 //     f = d1 * exp(-d2 / 2 * (x' - mu)^T Sigma^-1 (x' - mu))
 // per neighbour cell (d1 < 0, so f is minimized; Magnusson Eq. 6.9-6.10). T = T_target_source is
@@ -47,6 +49,9 @@ struct NdtConfig {
   double outlier_ratio = 0.55;          ///< weight of the uniform part of the mixture, (0, 1)
   std::size_t min_points_per_cell = 6;  ///< fewer points: the cell is not used
   double min_eigenvalue_ratio = 0.01;   ///< eigenvalue clamp, relative to the largest, (0, 1]
+  /// A cell whose middle eigenvalue is below this share of its largest holds a line of points
+  /// (one scan's ring across the ground, which moves with the sensor): not used; 0 keeps them.
+  double line_cell_ratio = 0.02;
   int max_iterations = 35;              ///< per resolution
   double step_epsilon_m = 1e-3;         ///< converged when the translation step is below this...
   double step_epsilon_rad = 1e-4;       ///< ...and the rotation step below this
@@ -76,13 +81,13 @@ struct NdtCell {
 class NdtTarget {
  public:
   NdtTarget() = default;
-  /// From the statistics of a (local) map; cells with fewer than min_points_per_cell points or a
-  /// zero covariance are dropped.
+  /// From the statistics of a (local) map; cells with fewer than min_points_per_cell points, a
+  /// zero covariance or points along a line (NdtConfig::line_cell_ratio) are dropped.
   NdtTarget(const VoxelStatistics& stats, std::size_t min_points_per_cell = 6,
-            double min_eigenvalue_ratio = 0.01);
+            double min_eigenvalue_ratio = 0.01, double line_cell_ratio = 0.02);
   static NdtTarget fromPoints(std::span<const Eigen::Vector3d> points, double resolution_m,
                               std::size_t min_points_per_cell = 6,
-                              double min_eigenvalue_ratio = 0.01);
+                              double min_eigenvalue_ratio = 0.01, double line_cell_ratio = 0.02);
 
   double resolution_m() const { return resolution_m_; }
   const std::vector<NdtCell>& cells() const { return cells_; }
