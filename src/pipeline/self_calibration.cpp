@@ -175,8 +175,6 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
       p.estimate = calib::estimateTimeRotation(data.increments, data.gyro, limits);
       if (!lidar_only) last_data = std::move(data);
     } catch (const InputError& e) {
-      if (result.passes.empty())
-        throw InputError(fmt::format("{}: calibration failed: {}", recording.string(), e.what()));
       p.failed = e.what();
     }
     logger().info("calibration pass {} ({}): {}", result.passes.size() + 1, p.odometry,
@@ -186,8 +184,10 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
   };
   for (int i = 0; i < options.max_passes; ++i) {
     CalibrationPass p = pass(false, estimator);
-    if (!p.failed.empty()) break;  // keep the previous pass's rig
-    if (i == 0 && disagrees(p.estimate)) {
+    if (i > 0 && !p.failed.empty()) break;  // keep the previous pass's rig
+    // The first pass's registrations disagree with the gyro, or too few of them worked: a rig
+    // too wrong for the IMU's prediction to start them.
+    if (i == 0 && (!p.failed.empty() || disagrees(p.estimate))) {
       // Coarse: the rotation only, whatever its sigma (degrees are enough for the IMU's
       // prediction to start the registrations again).
       calib::TimeRotationOptions coarse = estimator;
@@ -198,6 +198,8 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
         result.rig = corrected(result.rig, c.estimate);
         continue;
       }
+      if (!p.failed.empty())
+        throw InputError(fmt::format("{}: calibration failed: {}", recording.string(), p.failed));
     }
     result.rig = corrected(result.rig, p.estimate);
     result.last = p.estimate;
