@@ -125,7 +125,7 @@ std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string
   const bool has_bh = find("x_bh_m") && find("y_bh_m");
   const std::size_t c_x = has_bh ? *find("x_bh_m") : require("x_m");
   const std::size_t c_y = has_bh ? *find("y_bh_m") : require("y_m");
-  const auto c_z = find("z_m"), c_height = find("height_m");
+  const auto c_z = find("z_m"), c_height = find("height_m"), c_sigma = find("dbh_sigma_m");
 
   std::vector<TreeRecord> trees;
   for (int number = 2; std::getline(in, line); ++number) {
@@ -153,6 +153,7 @@ std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string
     t.bh_xy_m = Eigen::Vector2d(number_in(c_x), number_in(c_y));
     t.ground_z_m = c_z ? number_in(*c_z) : kNaN;
     t.dbh_m = number_in(c_dbh);
+    t.dbh_sigma_m = c_sigma ? number_in(*c_sigma) : kNaN;
     t.height_m = c_height ? number_in(*c_height) : kNaN;
     trees.push_back(t);
   }
