@@ -40,8 +40,8 @@ struct TreeRecord {
   Eigen::Vector2d bh_xy_m;  ///< x_bh_m, y_bh_m; or x_m, y_m when the file has no breast height
   double ground_z_m = 0.0;  ///< z_m
   double dbh_m = 0.0;
-  double dbh_sigma_m = 0.0;
   double height_m = 0.0;
+  double dbh_sigma_m = 0.0;
 };
 
 /// Reads a trees.csv by its header's column names (id, x_m, y_m, dbh_m required; x_bh_m, y_bh_m,
