@@ -34,7 +34,8 @@ std::vector<Eigen::Vector3d> sparseScan(double x_m) {
     const double facing = std::atan2(to_sensor.y(), to_sensor.x());
     for (double z = -kSensorHeight_m; z < 3.0; z += 0.3)
       for (double a = -1.2; a <= 1.2; a += 0.1) {
-        const Eigen::Vector2d p = stem + 0.15 * Eigen::Vector2d(std::cos(facing + a), std::sin(facing + a));
+        const Eigen::Vector2d p =
+            stem + 0.15 * Eigen::Vector2d(std::cos(facing + a), std::sin(facing + a));
         points.emplace_back(p.x() - x_m, p.y(), z);
       }
   }

@@ -51,8 +51,7 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
       if ((a.bh_xy_m - b.bh_xy_m).norm() < 0.2) {
         const double difference_m = a.dbh_m - b.dbh_m;
         ++matched;
-        EXPECT_LE(std::abs(difference_m),
-                  3.0 * std::hypot(a.dbh_sigma_m, b.dbh_sigma_m) + 0.005)
+        EXPECT_LE(std::abs(difference_m), 3.0 * std::hypot(a.dbh_sigma_m, b.dbh_sigma_m) + 0.005)
             << "stem at " << a.bh_xy_m.transpose();
         if (a.dbh_sigma_m < 0.02 && b.dbh_sigma_m < 0.02) {
           sq += difference_m * difference_m;

@@ -45,7 +45,8 @@ struct TreeRecord {
 };
 
 /// Reads a trees.csv by its header's column names (id, x_m, y_m, dbh_m required; x_bh_m, y_bh_m,
-/// z_m, dbh_sigma_m, height_m used when present). InputError naming the file, line and column otherwise.
+/// z_m, dbh_sigma_m, height_m used when present). InputError naming the file, line and column
+/// otherwise.
 std::vector<TreeRecord> readTreesCsv(const std::filesystem::path& path);
 /// The same from a file's text (tests, fuzzing); `source` names it in messages.
 std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string& source);
