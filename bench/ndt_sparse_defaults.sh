@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # NDT settings for sparse lidars (fewer than 64 beams), side by side on the same simulated
-# recordings (BENCHMARK.md, "NDT for sparse lidars"): each case is simulated once, then run with
+# recordings (BENCHMARK.md, "Session 40"): each case is simulated once, then run with
 # each variant of the odometry settings layered on the simulator's rig.yaml.
 #   bench/ndt_sparse_defaults.sh [OUT_DIR]
 #   TAIGA=path/to/taiga  CASES="scenario:beams:seed ..."  DURATION=60  REALISM=ideal

@@ -42,8 +42,9 @@ std::vector<Eigen::Vector3d> sparseScan(double x_m) {
   return points;
 }
 
-/// How far NDT (1 m cells, each point against its own cell) leaves the scan taken 0.3 m ahead
-/// of the map's, started from the true pose, along the walk (m; negative: pulled back).
+/// How far NDT (1 m cells, each point against its own cell) leaves the scan taken 0.1 m ahead
+/// of the map's (a scan at 1 m/s), started from the true pose, along the walk (m; negative:
+/// pulled back).
 double pullAlongWalk_m(double line_cell_ratio) {
   NdtConfig config;
   config.resolution_m = 1.0;
