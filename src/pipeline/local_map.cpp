@@ -5,10 +5,12 @@
 namespace taiga::pipeline {
 
 LocalMap::LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m, int max_keyframes,
-                   Target target, const registration::GicpConfig& gicp)
+                   Target target, const registration::GicpConfig& gicp,
+                   const registration::NdtConfig& ndt)
     : max_keyframes_(max_keyframes),
       target_(target),
       gicp_config_(gicp),
+      ndt_cells_(ndt),
       point_statistics_(point_spacing_m) {
   setNdtResolutions(ndt_resolutions_m);
 }
@@ -33,7 +35,8 @@ LocalMap::SearchStructures LocalMap::build() const {
   const std::vector<Eigen::Vector3d> points = point_statistics_.means();
   if (target_ == Target::kNdt) {
     for (const registration::VoxelStatistics& statistics : ndt_statistics_)
-      built.ndt_targets.push_back(std::make_unique<registration::NdtTarget>(statistics));
+      built.ndt_targets.push_back(
+          std::make_unique<registration::NdtTarget>(statistics, ndt_cells_));
   } else {
     built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
   }

@@ -121,9 +121,7 @@ RegistrationResult coarseToFine(std::span<const Eigen::Vector3d> source,
   RegistrationResult result;
   int iterations = 0;
   for (double resolution : resolutions(config)) {
-    const NdtTarget ndt_target =
-        NdtTarget::fromPoints(target, resolution, config.min_points_per_cell,
-                              config.min_eigenvalue_ratio, config.line_cell_ratio);
+    const NdtTarget ndt_target = NdtTarget::fromPoints(target, resolution, config);
     result = align_one(source, ndt_target, T, config);
     iterations += result.iterations;
     if (result.num_inliers == 0) break;

@@ -47,10 +47,9 @@ NdtConstants ndtConstants(double resolution_m, double outlier_ratio) {
   return k;
 }
 
-NdtTarget::NdtTarget(const VoxelStatistics& stats, std::size_t min_points_per_cell,
-                     double min_eigenvalue_ratio, double line_cell_ratio)
+NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
     : resolution_m_(stats.resolution_m()), inverse_resolution_(1.0 / stats.resolution_m()) {
-  for (const CellMoments& m : stats.moments(min_points_per_cell)) {
+  for (const CellMoments& m : stats.moments(cells.min_points_per_cell)) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(m.covariance);
     Eigen::Vector3d lambda = solver.eigenvalues();
     const double lambda_max = lambda.maxCoeff();
@@ -59,8 +58,8 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, std::size_t min_points_per_ce
     // few scans most such cells are one ring across the ground or a slope, and a ring keeps its
     // range from the sensor as the sensor moves: scored against it, the next scan's ring pulls
     // the pose back towards the map's viewpoint (16 beams: 2.4 m behind after 3 s of walking).
-    if (lambda(1) < line_cell_ratio * lambda_max) continue;
-    lambda = lambda.cwiseMax(min_eigenvalue_ratio * lambda_max);
+    if (lambda(1) < cells.line_cell_ratio * lambda_max) continue;
+    lambda = lambda.cwiseMax(cells.min_eigenvalue_ratio * lambda_max);
     const Eigen::Matrix3d& V = solver.eigenvectors();
     NdtCell cell;
     cell.mean = m.mean;
@@ -74,11 +73,10 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, std::size_t min_points_per_ce
 }
 
 NdtTarget NdtTarget::fromPoints(std::span<const Eigen::Vector3d> points, double resolution_m,
-                                std::size_t min_points_per_cell, double min_eigenvalue_ratio,
-                                double line_cell_ratio) {
+                                const NdtConfig& cells) {
   VoxelStatistics stats(resolution_m);
   stats.add(points);
-  return NdtTarget(stats, min_points_per_cell, min_eigenvalue_ratio, line_cell_ratio);
+  return NdtTarget(stats, cells);
 }
 
 int NdtTarget::neighbours(const Eigen::Vector3d& p, NeighbourSearch search,

@@ -128,7 +128,7 @@ std::vector<NdtTarget> ndtTargets(const Points& map, const NdtConfig& config) {
   for (const double r : resolutions) {
     VoxelStatistics stats(r);
     stats.add(map);
-    targets.emplace_back(stats, config.min_points_per_cell, config.min_eigenvalue_ratio);
+    targets.emplace_back(stats, config);
   }
   return targets;
 }

@@ -71,8 +71,10 @@ TEST(NdtLineCells, LinesAreDroppedPlanesKept) {
   for (int i = 0; i < 50; ++i) points.emplace_back(0.1 + 0.016 * i, 0.5, 0.5);
   for (int i = 0; i < 10; ++i)
     for (int j = 0; j < 10; ++j) points.emplace_back(2.1 + 0.08 * i, 0.1 + 0.08 * j, 0.5);
-  EXPECT_EQ(NdtTarget::fromPoints(points, 1.0, 6, 0.01, 0.02).cells().size(), 1u);
-  EXPECT_EQ(NdtTarget::fromPoints(points, 1.0, 6, 0.01, 0.0).cells().size(), 2u);
+  NdtConfig keep_lines;
+  keep_lines.line_cell_ratio = 0.0;
+  EXPECT_EQ(NdtTarget::fromPoints(points, 1.0).cells().size(), 1u);
+  EXPECT_EQ(NdtTarget::fromPoints(points, 1.0, keep_lines).cells().size(), 2u);
   NdtConfig bad;
   bad.line_cell_ratio = 1.0;
   EXPECT_THROW(bad.validate(), std::invalid_argument);

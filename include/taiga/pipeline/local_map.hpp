@@ -39,8 +39,10 @@ class LocalMap {
   /// NDT cells at each of ndt_resolutions_m (coarse to fine, at least one); the kd-tree
   /// (fitness, GICP) over one point per point_spacing_m voxel, so overlapping keyframes do not
   /// multiply its size.
+  /// `ndt`: the cell rules of the NDT targets (NdtTarget; not its resolutions).
   LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m, int max_keyframes,
-           Target target, const registration::GicpConfig& gicp = {});
+           Target target, const registration::GicpConfig& gicp = {},
+           const registration::NdtConfig& ndt = {});
   ~LocalMap();
   LocalMap(const LocalMap&) = delete;  // the background build refers to this object
   LocalMap& operator=(const LocalMap&) = delete;
@@ -92,6 +94,7 @@ class LocalMap {
   int max_keyframes_;
   Target target_;
   registration::GicpConfig gicp_config_;
+  registration::NdtConfig ndt_cells_;  ///< the NDT targets' cell rules
   struct Keyframe {
     std::uint64_t id = 0;
     lie::SE3 T_odom_keyframe;

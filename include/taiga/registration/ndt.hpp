@@ -81,13 +81,13 @@ struct NdtCell {
 class NdtTarget {
  public:
   NdtTarget() = default;
-  /// From the statistics of a (local) map; cells with fewer than min_points_per_cell points, a
-  /// zero covariance or points along a line (NdtConfig::line_cell_ratio) are dropped.
-  NdtTarget(const VoxelStatistics& stats, std::size_t min_points_per_cell = 6,
-            double min_eigenvalue_ratio = 0.01, double line_cell_ratio = 0.02);
+  /// From the statistics of a (local) map, at their resolution, with the cell rules of `cells`
+  /// (its resolutions are not used): cells with fewer than min_points_per_cell points, a zero
+  /// covariance or points along a line (line_cell_ratio) are dropped, the others' eigenvalues
+  /// clamped at min_eigenvalue_ratio.
+  explicit NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells = {});
   static NdtTarget fromPoints(std::span<const Eigen::Vector3d> points, double resolution_m,
-                              std::size_t min_points_per_cell = 6,
-                              double min_eigenvalue_ratio = 0.01, double line_cell_ratio = 0.02);
+                              const NdtConfig& cells = {});
 
   double resolution_m() const { return resolution_m_; }
   const std::vector<NdtCell>& cells() const { return cells_; }
