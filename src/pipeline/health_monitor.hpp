@@ -35,6 +35,10 @@ struct HealthEvidence {
   imu::ImuBias bias;
   bool estimates_bias = false;
   double imu_gap_s = 0.0;  ///< the longest stretch without IMU readings before the scan, s
+  /// Registered from near the last keyframe's own viewpoint (standing, or just after a
+  /// keyframe): it matches mostly the points it was made of, so its fitness says nothing of what
+  /// the scans a metre on will show and never enters the fitness yardstick.
+  bool at_keyframe_viewpoint = false;
 };
 
 class HealthMonitor {
@@ -72,11 +76,10 @@ class HealthMonitor {
 
   HealthConfig config_;
   double max_fitness_m2_;
-  struct Recent {
-    double fitness_m2 = 0.0;
-    double inlier_share = 0.0;
-  };
-  std::deque<Recent> history_;  ///< the latest ok scans' registrations, oldest first
+  /// The latest ok scans' registrations, oldest first: the fitness of those away from the
+  /// keyframes' viewpoints, the inlier share of all.
+  std::deque<double> fitness_history_m2_;
+  std::deque<double> inlier_share_history_;
   std::optional<double> last_ok_t_s_;
   std::optional<double> previous_t_s_;
   Eigen::Vector3d previous_v_odom_ = Eigen::Vector3d::Zero();

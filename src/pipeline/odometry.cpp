@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "health_monitor.hpp"
 #include "lidar_factor.hpp"
@@ -17,6 +18,11 @@ namespace taiga::pipeline {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// A scan within this share of the keyframe spacing from the last keyframe is registered from
+/// that keyframe's own viewpoint (HealthEvidence::at_keyframe_viewpoint): a quarter, so that a
+/// rig moving at any pace still feeds the health monitor's yardstick with most of its scans.
+constexpr double kKeyframeViewpointShare = 0.25;
 
 /// The fitness is a mean over the scan's points; its nearest-neighbour searches cost as much as
 /// the NDT passes, so a dense scan (a full OS0-128 scan leaves 16000 voxels) is scored on every
@@ -83,7 +89,8 @@ Odometry::Odometry(const OdometryConfig& config, const RigConfig& rig, bool lida
       local_map_(localMapResolutionsM(config, lidar_only), config.local_map_voxel_m,
                  config.local_map_keyframes,
                  registration_.method == registration::Method::kGicp ? LocalMap::Target::kGicp
-                                                                     : LocalMap::Target::kNdt),
+                                                                     : LocalMap::Target::kNdt,
+                 registration_.gicp, registration_.ndt),
       health_(std::make_unique<HealthMonitor>(config.health, config.max_fitness_m2)),
       wide_basin_(std::make_unique<WideBasin>(config)) {}
 
@@ -220,7 +227,7 @@ registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::V
   registration::RegistrationResult result;
   if (registration_.method == registration::Method::kGicp) {
     result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),
-                                     guess_T_odom_body, {});
+                                     guess_T_odom_body, registration_.gicp);
   } else {
     // Coarse to fine: each pass starts from the previous one's pose.
     lie::SE3 guess = guess_T_odom_body;
@@ -244,16 +251,19 @@ registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::V
 
 void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
   const registration::RegistrationResult& r = outcome.registration;
-  outcome.health = health_->judge({.t_s = outcome.t_s,
-                                   .registered = registered,
-                                   .lidar = outcome.lidar,
-                                   .lidar_note = outcome.lidar_note,
-                                   .fitness_m2 = r.fitness_m2,
-                                   .inlier_share = inlierShare(r, outcome.source_points),
-                                   .v_odom = outcome.v_odom,
-                                   .bias = outcome.bias,
-                                   .estimates_bias = !lidar_only_,
-                                   .imu_gap_s = outcome.imu_gap_s});
+  outcome.health = health_->judge(
+      {.t_s = outcome.t_s,
+       .registered = registered,
+       .lidar = outcome.lidar,
+       .lidar_note = outcome.lidar_note,
+       .fitness_m2 = r.fitness_m2,
+       .inlier_share = inlierShare(r, outcome.source_points),
+       .v_odom = outcome.v_odom,
+       .bias = outcome.bias,
+       .estimates_bias = !lidar_only_,
+       .imu_gap_s = outcome.imu_gap_s,
+       .at_keyframe_viewpoint = fromLastKeyframe_m(outcome.T_odom_body) <
+                                kKeyframeViewpointShare * config_.keyframe_distance_m});
   if (health_->restartLocalMap()) {
     // Lost for long: the old local map no longer explains the scans. A new segment starts with
     // this scan, placed by dead reckoning (docs/odometry.md, "Health").
@@ -268,17 +278,18 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
   outcome.map_segment = map_segment_;
 }
 
+double Odometry::fromLastKeyframe_m(const lie::SE3& T_odom_body) const {
+  if (!last_keyframe_T_odom_body_) return std::numeric_limits<double>::infinity();
+  const lie::Vector6 moved = (last_keyframe_T_odom_body_->inverse() * T_odom_body).Log();
+  return (T_odom_body.translation() - last_keyframe_T_odom_body_->translation()).norm() +
+         config_.keyframe_rotation_weight_m_per_rad * moved.tail<3>().norm();
+}
+
 void Odometry::maybeAddKeyframe(ScanOutcome& outcome, PointCloud&& cloud_in_body) {
   // A scan the monitor distrusts never enters the map, but an empty map takes the next scan
   // whatever its status: there is nothing else to register to.
   if (outcome.health.status != ScanStatus::kOk && !local_map_.empty()) return;
-  if (last_keyframe_T_odom_body_) {
-    const lie::Vector6 moved = (last_keyframe_T_odom_body_->inverse() * outcome.T_odom_body).Log();
-    const double travelled_m =
-        (outcome.T_odom_body.translation() - last_keyframe_T_odom_body_->translation()).norm() +
-        config_.keyframe_rotation_weight_m_per_rad * moved.tail<3>().norm();
-    if (travelled_m < config_.keyframe_distance_m) return;
-  }
+  if (fromLastKeyframe_m(outcome.T_odom_body) < config_.keyframe_distance_m) return;
   outcome.keyframe_id = keyframes_made_++;
   last_keyframe_T_odom_body_ = outcome.T_odom_body;
   local_map_.addKeyframe(

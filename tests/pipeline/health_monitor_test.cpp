@@ -80,6 +80,43 @@ TEST(HealthMonitor, ScansItDistrustsNeverBecomeTheYardstick) {
   EXPECT_EQ(statuses.back(), ScanStatus::kLost);
 }
 
+TEST(HealthMonitor, ScansFromTheKeyframesOwnViewpointNeverBecomeTheFitnessYardstick) {
+  // A rig standing on its first keyframe for 3 s matches its own points (fitness 0.03 m^2);
+  // driving off, a sparse map fits 0.3 m on at 0.15 m^2, and further on at up to 0.3 m^2.
+  HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
+  double t_s = 0.0;
+  for (int k = 0; k < 30; ++k, t_s += kPeriod_s) {
+    HealthEvidence standing = goodScan(t_s);
+    standing.fitness_m2 = 0.03;
+    standing.at_keyframe_viewpoint = true;
+    EXPECT_EQ(monitor.judge(standing).status, ScanStatus::kOk);
+  }
+  EXPECT_TRUE(monitor.hasYardstick()) << "a working registration, though no fitness yardstick";
+  // Their inlier share is a yardstick: a scan driving off that matches a third as much is not ok.
+  HealthEvidence unmatched = goodScan(t_s);
+  unmatched.inlier_share = 0.3;
+  EXPECT_EQ(monitor.judge(unmatched).status, ScanStatus::kDegraded);
+  t_s += kPeriod_s;
+  for (int k = 0; k < 30; ++k, t_s += kPeriod_s) {
+    HealthEvidence moving = goodScan(t_s);
+    moving.fitness_m2 = 0.15 + 0.005 * k;
+    EXPECT_EQ(monitor.judge(moving).status, ScanStatus::kOk) << "moving scan " << k;
+  }
+  // The yardstick the moving scans taught still finds a registration gone wrong.
+  HealthEvidence wrong = goodScan(t_s);
+  wrong.fitness_m2 = 1.5;
+  EXPECT_EQ(monitor.judge(wrong).status, ScanStatus::kDegraded);
+  // And a stop on a keyframe later in the run keeps it: standing scans do not displace it.
+  for (int k = 0; k < 30; ++k) {
+    HealthEvidence standing = goodScan(t_s += kPeriod_s);
+    standing.fitness_m2 = 0.03;
+    standing.at_keyframe_viewpoint = true;
+    monitor.judge(standing);
+  }
+  wrong.t_s = t_s + kPeriod_s;
+  EXPECT_EQ(monitor.judge(wrong).status, ScanStatus::kDegraded);
+}
+
 TEST(HealthMonitor, AFewMatchedPointsAreDegraded) {
   HealthMonitor monitor(HealthConfig{}, kMaxFitness_m2);
   HealthEvidence scan = goodScan(warmUp(monitor, 10));

@@ -150,6 +150,9 @@ class Odometry {
   /// One registration from one guess, with its fitness.
   registration::RegistrationResult alignToMap(const std::vector<Eigen::Vector3d>& source,
                                               const lie::SE3& guess_T_odom_body) const;
+  /// How far T_odom_body is from the last keyframe by the keyframe rule (distance plus
+  /// keyframe_rotation_weight_m_per_rad times the rotation), m; infinite before the first.
+  double fromLastKeyframe_m(const lie::SE3& T_odom_body) const;
   /// Takes the scan's full cloud: a keyframe keeps it in its outcome.
   void maybeAddKeyframe(ScanOutcome& outcome, PointCloud&& cloud_in_body);
   void judgeHealth(ScanOutcome& outcome, bool registered);
