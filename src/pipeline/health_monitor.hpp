@@ -52,7 +52,7 @@ class HealthMonitor {
   /// not finite or above max_fitness_m2, or far from the recent history.
   bool registrationSuspect(double fitness_m2, double inlier_share) const;
   /// Whether the recent history is long enough to judge against (not right after the local map
-  /// started over).
+  /// started over); the fitness may still lack one (a rig standing since the start).
   bool hasYardstick() const;
   /// Time from the last ok scan to t_s, s; 0 before the first scan.
   double sinceOk_s(double t_s) const { return last_ok_t_s_ ? t_s - *last_ok_t_s_ : 0.0; }
