@@ -2,6 +2,7 @@
 // list and a classified map, from a run directory or any LAS/PLY/PCD cloud.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "taiga/georef/georef_files.hpp"
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/io/las_writer.hpp"
+#include "taiga/io/trajectory_io.hpp"
 #include "taiga/trees/inventory.hpp"
 #include "taiga/trees/tree_files.hpp"
 
@@ -47,6 +49,26 @@ Eigen::Vector3d roundOffset(const std::vector<Eigen::Vector3d>& points_m) {
   for (const Eigen::Vector3d& p : points_m)
     if (p.allFinite()) return (p / 100.0).array().floor() * 100.0;
   return Eigen::Vector3d::Zero();
+}
+
+// The sensor position of each point of a run's map.las (local coordinates, like the points):
+// its keyframe's, the first keyframe stamped at or after the point's time (a keyframe carries
+// its scan's end time). Empty when the map has no point times or the run no keyframes.tum.
+std::vector<Eigen::Vector3d> keyframeViewpoints(const fs::path& run_dir, const PointCloud& map,
+                                                const Eigen::Vector3d& offset_m) {
+  const fs::path keyframes_tum = run_dir / "keyframes.tum";
+  if (!map.hasTimes() || !fs::exists(keyframes_tum)) return {};
+  const Trajectory keyframes = io::readTum(keyframes_tum);
+  if (keyframes.empty()) return {};
+  std::vector<Eigen::Vector3d> viewpoints_m(map.size());
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    const auto after = std::lower_bound(
+        keyframes.begin(), keyframes.end(), map.times_s[i],
+        [](const StampedPose& k, double t_s) { return k.t_s < t_s; });
+    const StampedPose& k = after == keyframes.end() ? keyframes.back() : *after;
+    viewpoints_m[i] = k.pose.translation() - offset_m;
+  }
+  return viewpoints_m;
 }
 
 int runTrees(const TreesOptions& options) {
@@ -90,7 +112,11 @@ int runTrees(const TreesOptions& options) {
   io_options.stems.min_dbh_m = options.min_dbh_m;
   io_options.stems.breast_height_m = options.breast_height_m;
   io_options.stems.max_fit_rms_m = options.max_fit_rms_m;
-  const trees::Inventory inventory = trees::takeInventory(local, io_options);
+  // A run's map knows where its sensor was: the DBH fit measures range noise along the beams.
+  const std::vector<Eigen::Vector3d> viewpoints_m =
+      run_dir && options.epsg == 0 ? keyframeViewpoints(input, cloud, offset_m)
+                                   : std::vector<Eigen::Vector3d>{};
+  const trees::Inventory inventory = trees::takeInventory(local, io_options, viewpoints_m);
   const std::vector<trees::Stem>& stems = inventory.stems;
 
   trees::writeTreesCsv(out / "trees.csv", stems, offset_m, grid);
@@ -128,6 +154,9 @@ int runTrees(const TreesOptions& options) {
   fmt::print("stems      {} ({} good, {} seen from one side, {} poor){}\n", stems.size(), good,
              partial, stems.size() - good - partial,
              grid ? fmt::format("; in EPSG:{}", grid->epsg) : "");
+  fmt::print("DBH fit    {}\n", viewpoints_m.empty()
+                                   ? "residuals across the surface (no sensor positions)"
+                                   : "residuals along the beams (sensor at each keyframe)");
   if (stems.empty())
     fmt::print(
         "           none found: heights are measured from the lowest points of each {} m "

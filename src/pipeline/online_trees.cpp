@@ -100,16 +100,18 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
     crop_m = std::max(crop_m, distanceXy(k.T_map_body.translation(), center));
   crop_m += kCropMargin_m;
 
-  std::vector<Eigen::Vector3d> points_m;
+  std::vector<Eigen::Vector3d> points_m, viewpoints_m;
   for (const Keyframe& k : all) {
     if (nearestFresh(k.T_map_body.translation()) > kRegionKeyframes_m) continue;
     for (const Eigen::Vector3d& p_body : store_.load(k.id).positions) {
       const Eigen::Vector3d p = k.T_map_body * p_body;
-      if (distanceXy(p, center) <= crop_m) points_m.push_back(p);
+      if (distanceXy(p, center) > crop_m) continue;
+      points_m.push_back(p);
+      viewpoints_m.push_back(k.T_map_body.translation());
     }
   }
   if (points_m.empty()) return;
-  const trees::Inventory inventory = trees::takeInventory(points_m);
+  const trees::Inventory inventory = trees::takeInventory(points_m, {}, viewpoints_m);
 
   for (const trees::Stem& stem : inventory.stems) {
     const bool seen_here = nearestFresh(stem.position_m) <= kSeen_m;
@@ -144,12 +146,14 @@ std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
   // The final list: one inventory of the whole map on the graph's final poses, the same as
   // `taiga trees RUN` on map.las. The incremental list saw each stem only from the keyframes
   // around it at the time, on live poses (docs/trees.md, "Online").
-  std::vector<Eigen::Vector3d> points_m;
+  std::vector<Eigen::Vector3d> points_m, viewpoints_m;
   for (std::uint64_t id = 0; id < final_T_map_body.size() && id < store_.size(); ++id)
-    for (const Eigen::Vector3d& p_body : store_.load(id).positions)
+    for (const Eigen::Vector3d& p_body : store_.load(id).positions) {
       points_m.push_back(final_T_map_body[id] * p_body);
+      viewpoints_m.push_back(final_T_map_body[id].translation());
+    }
   try {
-    const trees::Inventory inventory = trees::takeInventory(points_m);
+    const trees::Inventory inventory = trees::takeInventory(points_m, {}, viewpoints_m);
     writeCsv(inventory.stems);
     return inventory.stems.size();
   } catch (const InputError& e) {  // no points, or a map too large for one terrain grid

@@ -92,30 +92,60 @@ double arcCoverageDeg(std::span<const Vector2d> points_m, const std::vector<doub
   return 10.0 * static_cast<double>(std::count(sector.begin(), sector.end(), true));
 }
 
+// One point's residual and its gradient in (cx, cy, r), or nothing when the point cannot be
+// scored (its beam misses the circle or grazes it).
+struct Residual {
+  double e_m;
+  Eigen::Vector3d J;
+};
+std::optional<Residual> residualOf(const Vector2d& p, const Vector2d* beam, const Circle& circle) {
+  const Vector2d d = p - circle.center_m;
+  const double distance = d.norm();
+  if (!(distance > 1e-9)) return std::nullopt;
+  if (beam == nullptr) {
+    // Across the surface: e = |p - c| - r; de/dc = -(p - c) / |p - c|, de/dr = -1.
+    return Residual{distance - circle.radius_m,
+                    Eigen::Vector3d(-d.x() / distance, -d.y() / distance, -1.0)};
+  }
+  // Along the beam v: p + s v meets the circle's near side at s = -(d.v) - sqrt(disc), from
+  // |d + s v|^2 = r^2; e = -s (the range error). Differentiating |q|^2 = r^2 with q = d + s v
+  // (centre to intersection): ds/dc = q / (q.v), ds/dr = r / (q.v).
+  const double b = d.dot(*beam);
+  const double disc = b * b - (distance * distance - circle.radius_m * circle.radius_m);
+  if (!(disc > 0.0)) return std::nullopt;
+  const double s = -b - std::sqrt(disc);
+  const Vector2d q = d + s * *beam;
+  const double qv = q.dot(*beam);  // -sqrt(disc): how squarely the beam meets the surface
+  // Beyond 78 deg incidence the intersection runs away with the circle: not scored.
+  if (std::abs(qv) < 0.2 * circle.radius_m) return std::nullopt;
+  return Residual{-s, Eigen::Vector3d(-q.x() / qv, -q.y() / qv, -circle.radius_m / qv)};
+}
+
 }  // namespace
 
 std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const Vector2d& center_m,
-                                      double radius_m, const CircleFitOptions& options) {
+                                      double radius_m, const CircleFitOptions& options,
+                                      std::span<const Vector2d> beams) {
   if (points_m.size() < 5) return std::nullopt;
+  const auto beamOf = [&](std::size_t i) -> const Vector2d* {
+    return beams.empty() || !(beams[i].squaredNorm() > 0.5) ? nullptr : &beams[i];
+  };
   Circle circle{center_m, radius_m};
   const double scale_m = robustScale(points_m, circle, options.inlier_band_m);
   const double tukey_m = 4.685 * scale_m;
   std::vector<double> weights(points_m.size(), 0.0);
   Eigen::Matrix3d JtWJ;
   for (int iteration = 0; iteration < 30; ++iteration) {
-    // Gauss-Newton on e_i = |p_i - c| - r: de/dc = -(p_i - c) / |p_i - c|, de/dr = -1.
+    // Iteratively reweighted Gauss-Newton on the residuals (residualOf).
     JtWJ.setZero();
     Eigen::Vector3d JtWe = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < points_m.size(); ++i) {
-      const Vector2d d = points_m[i] - circle.center_m;
-      const double distance = d.norm();
-      const double e = distance - circle.radius_m;
-      const double u = e / tukey_m;
-      weights[i] = (std::abs(u) < 1.0 && distance > 1e-9) ? (1 - u * u) * (1 - u * u) : 0.0;
+      const std::optional<Residual> r = residualOf(points_m[i], beamOf(i), circle);
+      const double u = r ? r->e_m / tukey_m : 1.0;
+      weights[i] = std::abs(u) < 1.0 ? (1 - u * u) * (1 - u * u) : 0.0;
       if (weights[i] == 0.0) continue;
-      const Eigen::Vector3d J(-d.x() / distance, -d.y() / distance, -1.0);
-      JtWJ += weights[i] * J * J.transpose();
-      JtWe += weights[i] * J * e;
+      JtWJ += weights[i] * r->J * r->J.transpose();
+      JtWe += weights[i] * r->J * r->e_m;
     }
     if (std::count_if(weights.begin(), weights.end(), [](double w) { return w > 0; }) < 5)
       return std::nullopt;
@@ -134,12 +164,19 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const 
   double weighted_sq = 0.0, weight_sum = 0.0, inlier_sq = 0.0;
   for (std::size_t i = 0; i < points_m.size(); ++i) {
     if (weights[i] <= 0.0) continue;
-    const double e = (points_m[i] - circle.center_m).norm() - circle.radius_m;
-    weighted_sq += weights[i] * e * e;
+    const std::optional<Residual> r = residualOf(points_m[i], beamOf(i), circle);
+    if (!r) {  // the last step moved the circle off this point's beam
+      weights[i] = 0.0;
+      continue;
+    }
+    weighted_sq += weights[i] * r->e_m * r->e_m;
     weight_sum += weights[i];
-    inlier_sq += e * e;
+    // The RMS measures the surface's scatter across it, whichever residual was fitted.
+    const double across_m = (points_m[i] - circle.center_m).norm() - circle.radius_m;
+    inlier_sq += across_m * across_m;
     ++fit.inliers;
   }
+  if (fit.inliers == 0) return std::nullopt;
   fit.rms_m = std::sqrt(inlier_sq / static_cast<double>(fit.inliers));
   // Covariance of (cx, cy, r): sigma^2 (J^T W J)^-1 with sigma^2 the weighted residual variance.
   const double dof = std::max(1.0, weight_sum - 3.0);

@@ -5,11 +5,11 @@
 
 namespace taiga::trees {
 
-Inventory takeInventory(std::span<const Eigen::Vector3d> points_m,
-                        const InventoryOptions& options) {
+Inventory takeInventory(std::span<const Eigen::Vector3d> points_m, const InventoryOptions& options,
+                        std::span<const Eigen::Vector3d> viewpoints_m) {
   Inventory inventory;
   inventory.terrain = buildTerrainModel(points_m, options.terrain);
-  inventory.stems = detectStems(points_m, inventory.terrain, options.stems);
+  inventory.stems = detectStems(points_m, inventory.terrain, options.stems, viewpoints_m);
   return inventory;
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 
 #include "taiga/core/hash.hpp"
 #include "taiga/trees/circle_fit.hpp"
@@ -24,11 +25,12 @@ std::int64_t cellKey(std::int64_t ix, std::int64_t iy) { return (ix << 32) ^ (iy
 template <typename T>
 using CellMap = tsl::robin_map<std::int64_t, T, MixedKeyHash>;
 
-// Points as (x, y, height above ground), bucketed by square columns for disc queries.
+// Points as (x, y, height above ground), bucketed by square columns for disc queries, with the
+// (x, y) of the sensor that saw each one when known.
 class ColumnIndex {
  public:
-  ColumnIndex(std::vector<Vector3d> points_xyh, double cell_m)
-      : points_(std::move(points_xyh)), cell_m_(cell_m) {
+  ColumnIndex(std::vector<Vector3d> points_xyh, std::vector<Vector2d> viewpoints_xy, double cell_m)
+      : points_(std::move(points_xyh)), viewpoints_(std::move(viewpoints_xy)), cell_m_(cell_m) {
     std::vector<std::pair<std::int64_t, std::uint32_t>> keyed(points_.size());
     for (std::size_t i = 0; i < points_.size(); ++i)
       keyed[i] = {keyOf(points_[i].head<2>()), static_cast<std::uint32_t>(i)};
@@ -43,7 +45,15 @@ class ColumnIndex {
 
   const std::vector<Vector3d>& points() const { return points_; }
 
-  /// Calls f(point) for the points within `radius_m` of `center_m` with h_lo <= h < h_hi.
+  /// The horizontal direction from the sensor to point i (unit), zero when unknown.
+  Vector2d beamOf(std::uint32_t i) const {
+    if (viewpoints_.empty()) return Vector2d::Zero();
+    const Vector2d beam = points_[i].head<2>() - viewpoints_[i];
+    const double length_m = beam.norm();
+    return length_m > 0.1 ? Vector2d(beam / length_m) : Vector2d::Zero();
+  }
+
+  /// Calls f(point, i) for the points within `radius_m` of `center_m` with h_lo <= h < h_hi.
   template <typename F>
   void forEachNear(const Vector2d& center_m, double radius_m, double h_lo, double h_hi,
                    F&& f) const {
@@ -55,7 +65,8 @@ class ColumnIndex {
         if (range == ranges_.end()) continue;
         for (std::size_t k = range->second.first; k < range->second.second; ++k) {
           const Vector3d& p = points_[order_[k]];
-          if (p.z() >= h_lo && p.z() < h_hi && (p.head<2>() - center_m).norm() <= radius_m) f(p);
+          if (p.z() >= h_lo && p.z() < h_hi && (p.head<2>() - center_m).norm() <= radius_m)
+            f(p, order_[k]);
         }
       }
   }
@@ -70,6 +81,7 @@ class ColumnIndex {
     return cellKey(ix, iy);
   }
   std::vector<Vector3d> points_;
+  std::vector<Vector2d> viewpoints_;  ///< empty, or one per point
   double cell_m_;
   std::vector<std::uint32_t> order_;
   CellMap<std::pair<std::size_t, std::size_t>> ranges_;
@@ -135,7 +147,7 @@ std::optional<Slice> trackSlice(const ColumnIndex& index, const Slice& from, dou
   const double max_shift_m = 0.04 + gap_m * std::tan(o.max_lean_deg / kDegPerRad);
   std::vector<Vector2d> near;
   index.forEachNear(from.center_m, from.radius_m + max_shift_m + 0.1, h_lo, h_hi,
-                    [&](const Vector3d& p) { near.push_back(p.head<2>()); });
+                    [&](const Vector3d& p, std::uint32_t) { near.push_back(p.head<2>()); });
   const std::optional<CircleFit> c = refineCircle(near, from.center_m, from.radius_m, fit);
   if (!c || c->inliers < 6 || c->arc_deg < 40.0) return std::nullopt;
   if ((c->center_m - from.center_m).norm() > max_shift_m) return std::nullopt;
@@ -234,13 +246,16 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
   const double lean_rad = std::atan(axis.slope.norm());
   if (lean_rad * kDegPerRad > o.max_lean_deg) return std::nullopt;
 
-  // DBH: the band's points with the lean taken out, fitted around the axis.
-  std::vector<Vector2d> upright;
-  index.forEachNear(
-      axis.at_breast_height, seed.radius_m + 0.15 + 0.3 * axis.slope.norm(), band_lo, band_hi,
-      [&](const Vector3d& p) { upright.push_back(p.head<2>() - axis.slope * (p.z() - bh)); });
+  // DBH: the band's points with the lean taken out, fitted around the axis; along each point's
+  // beam where the sensor's position is known (refineCircle).
+  std::vector<Vector2d> upright, beams;
+  index.forEachNear(axis.at_breast_height, seed.radius_m + 0.15 + 0.3 * axis.slope.norm(), band_lo,
+                    band_hi, [&](const Vector3d& p, std::uint32_t i) {
+                      upright.push_back(p.head<2>() - axis.slope * (p.z() - bh));
+                      beams.push_back(index.beamOf(i));
+                    });
   const std::optional<CircleFit> dbh_fit =
-      refineCircle(upright, axis.at_breast_height, seed.radius_m, fit);
+      refineCircle(upright, axis.at_breast_height, seed.radius_m, fit, beams);
   const double max_rms_m =
       slices.size() >= o.long_stem_slices ? o.max_fit_rms_m : 2.0 / 3.0 * o.max_fit_rms_m;
   if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > max_rms_m ||
@@ -283,24 +298,30 @@ std::string qualityName(StemQuality quality) {
 }
 
 std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainModel& terrain,
-                              const StemOptions& o) {
+                              const StemOptions& o, std::span<const Vector3d> viewpoints_m) {
+  if (!viewpoints_m.empty() && viewpoints_m.size() != points_m.size())
+    throw std::invalid_argument("detectStems: viewpoints_m must be empty or one per point");
   const double bh = o.breast_height_m;
   const double band_lo = bh - o.dbh_band_half_m, band_hi = bh + o.dbh_band_half_m;
   std::vector<Vector3d> slab;
-  std::vector<Vector2d> band;
+  std::vector<Vector2d> slab_viewpoints, band;
   constexpr double kCanopyPixel_m = 0.25;
   CellMap<double> canopy;  // the highest point per pixel, above the ground
-  for (const Vector3d& p : points_m) {
+  for (std::size_t i = 0; i < points_m.size(); ++i) {
+    const Vector3d& p = points_m[i];
     if (!p.allFinite()) continue;
     const double h = p.z() - terrain.heightAt(p.x(), p.y());
-    if (h >= o.lowest_slice_m && h < o.highest_slice_m) slab.emplace_back(p.x(), p.y(), h);
+    if (h >= o.lowest_slice_m && h < o.highest_slice_m) {
+      slab.emplace_back(p.x(), p.y(), h);
+      if (!viewpoints_m.empty()) slab_viewpoints.push_back(viewpoints_m[i].head<2>());
+    }
     if (h >= band_lo && h < band_hi) band.push_back(p.head<2>());
     const auto key = cellKey(static_cast<std::int64_t>(std::floor(p.x() / kCanopyPixel_m)),
                              static_cast<std::int64_t>(std::floor(p.y() / kCanopyPixel_m)));
     auto [it, inserted] = canopy.try_emplace(key, h);
     if (!inserted && h > it->second) it.value() = h;
   }
-  const ColumnIndex index(std::move(slab), 0.25);
+  const ColumnIndex index(std::move(slab), std::move(slab_viewpoints), 0.25);
   const CircleFitOptions fit{.min_radius_m = 0.5 * o.min_dbh_m * 0.7,
                              .max_radius_m = 0.5 * o.max_dbh_m,
                              .inlier_band_m = o.inlier_band_m};

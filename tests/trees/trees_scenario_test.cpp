@@ -73,7 +73,9 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   SCOPED_TRACE(trees.dump());
   EXPECT_GT(trees["reference"].get<int>(), 60);
   // Measured 97-98 % detection, 0-2 % commission, DBH RMSE 2.2-2.9 cm (bias -1.0 to -1.7 cm: the
-  // lidar map's stems are slimmer than the true ones, docs/trees.md), position RMSE 1.8-2.3 cm.
+  // lidar map's stems are slimmer than the true ones, docs/trees.md), position RMSE 1.8-2.3 cm,
+  // before the DBH fit measured range noise along the beams (session 41: on seed 12 DBH RMSE
+  // 1.38 cm, bias -0.35 cm; the bounds are not tightened yet, this seed's figures unmeasured).
   EXPECT_GE(trees["recall"].get<double>(), 0.92);
   EXPECT_LE(trees["commission"].get<double>(), 0.05);
   EXPECT_LE(trees["dbh_rmse_m"].get<double>(), 0.035);

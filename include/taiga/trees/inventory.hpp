@@ -28,9 +28,11 @@ struct Inventory {
   std::vector<Stem> stems;
 };
 
-/// Terrain and stems of `points_m` (local coordinates: subtract a large offset first).
+/// Terrain and stems of `points_m` (local coordinates: subtract a large offset first);
+/// `viewpoints_m` as in detectStems.
 Inventory takeInventory(std::span<const Eigen::Vector3d> points_m,
-                        const InventoryOptions& options = {});
+                        const InventoryOptions& options = {},
+                        std::span<const Eigen::Vector3d> viewpoints_m = {});
 
 struct PointLabels {
   std::vector<std::uint8_t> classification;  ///< kClassGround, kClassStem or kClassOther

@@ -82,8 +82,11 @@ struct Stem {
 };
 
 /// Stems in `points_m` (local coordinates, m) over `terrain`, sorted by x then y. Deterministic.
+/// `viewpoints_m`: empty, or per point the position of the sensor that measured it (a lidar map:
+/// the keyframe's), so the DBH fit measures range noise along the beams (circle_fit.hpp).
 std::vector<Stem> detectStems(std::span<const Eigen::Vector3d> points_m,
-                              const TerrainModel& terrain, const StemOptions& options = {});
+                              const TerrainModel& terrain, const StemOptions& options = {},
+                              std::span<const Eigen::Vector3d> viewpoints_m = {});
 
 /// Sorts by x, then y (the order of trees.csv).
 void sortByPosition(std::vector<Stem>& stems);
