@@ -62,9 +62,9 @@ std::vector<Eigen::Vector3d> keyframeViewpoints(const fs::path& run_dir, const P
   if (keyframes.empty()) return {};
   std::vector<Eigen::Vector3d> viewpoints_m(map.size());
   for (std::size_t i = 0; i < map.size(); ++i) {
-    const auto after = std::lower_bound(
-        keyframes.begin(), keyframes.end(), map.times_s[i],
-        [](const StampedPose& k, double t_s) { return k.t_s < t_s; });
+    const auto after =
+        std::lower_bound(keyframes.begin(), keyframes.end(), map.times_s[i],
+                         [](const StampedPose& k, double t_s) { return k.t_s < t_s; });
     const StampedPose& k = after == keyframes.end() ? keyframes.back() : *after;
     viewpoints_m[i] = k.pose.translation() - offset_m;
   }
@@ -113,9 +113,9 @@ int runTrees(const TreesOptions& options) {
   io_options.stems.breast_height_m = options.breast_height_m;
   io_options.stems.max_fit_rms_m = options.max_fit_rms_m;
   // A run's map knows where its sensor was: the DBH fit measures range noise along the beams.
-  const std::vector<Eigen::Vector3d> viewpoints_m =
-      run_dir && options.epsg == 0 ? keyframeViewpoints(input, cloud, offset_m)
-                                   : std::vector<Eigen::Vector3d>{};
+  const std::vector<Eigen::Vector3d> viewpoints_m = run_dir && options.epsg == 0
+                                                        ? keyframeViewpoints(input, cloud, offset_m)
+                                                        : std::vector<Eigen::Vector3d>{};
   const trees::Inventory inventory = trees::takeInventory(local, io_options, viewpoints_m);
   const std::vector<trees::Stem>& stems = inventory.stems;
 
@@ -155,8 +155,8 @@ int runTrees(const TreesOptions& options) {
              partial, stems.size() - good - partial,
              grid ? fmt::format("; in EPSG:{}", grid->epsg) : "");
   fmt::print("DBH fit    {}\n", viewpoints_m.empty()
-                                   ? "residuals across the surface (no sensor positions)"
-                                   : "residuals along the beams (sensor at each keyframe)");
+                                    ? "residuals across the surface (no sensor positions)"
+                                    : "residuals along the beams (sensor at each keyframe)");
   if (stems.empty())
     fmt::print(
         "           none found: heights are measured from the lowest points of each {} m "
