@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -53,7 +54,9 @@ Eigen::Vector3d roundOffset(const std::vector<Eigen::Vector3d>& points_m) {
 
 // The sensor position of each point of a run's map.las (local coordinates, like the points):
 // its keyframe's, the first keyframe stamped at or after the point's time (a keyframe carries
-// its scan's end time). Empty when the map has no point times or the run no keyframes.tum.
+// its scan's end time). Empty when the map has no point times or the run no keyframes.tum; NaN
+// (unknown: that point's residual stays across the surface) for a time no keyframe's scan can
+// hold, e.g. the zeros of a recording without per-point times.
 std::vector<Eigen::Vector3d> keyframeViewpoints(const fs::path& run_dir, const PointCloud& map,
                                                 const Eigen::Vector3d& offset_m) {
   const fs::path keyframes_tum = run_dir / "keyframes.tum";
@@ -65,8 +68,10 @@ std::vector<Eigen::Vector3d> keyframeViewpoints(const fs::path& run_dir, const P
     const auto after =
         std::lower_bound(keyframes.begin(), keyframes.end(), map.times_s[i],
                          [](const StampedPose& k, double t_s) { return k.t_s < t_s; });
-    const StampedPose& k = after == keyframes.end() ? keyframes.back() : *after;
-    viewpoints_m[i] = k.pose.translation() - offset_m;
+    constexpr double kLongestScan_s = 1.0;
+    viewpoints_m[i] = after != keyframes.end() && after->t_s - map.times_s[i] <= kLongestScan_s
+                          ? Eigen::Vector3d(after->pose.translation() - offset_m)
+                          : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   }
   return viewpoints_m;
 }
@@ -154,9 +159,15 @@ int runTrees(const TreesOptions& options) {
   fmt::print("stems      {} ({} good, {} seen from one side, {} poor){}\n", stems.size(), good,
              partial, stems.size() - good - partial,
              grid ? fmt::format("; in EPSG:{}", grid->epsg) : "");
-  fmt::print("DBH fit    {}\n", viewpoints_m.empty()
-                                    ? "residuals across the surface (no sensor positions)"
-                                    : "residuals along the beams (sensor at each keyframe)");
+  const auto with_sensor = std::count_if(viewpoints_m.begin(), viewpoints_m.end(),
+                                         [](const Eigen::Vector3d& v) { return v.allFinite(); });
+  if (with_sensor == 0)
+    fmt::print("DBH fit    residuals across the surface (no sensor positions: not a taiga run, or "
+               "a map without point times)\n");
+  else
+    fmt::print("DBH fit    residuals along the beams for {} of {} points (the sensor at their "
+               "keyframe), across the surface for the others\n",
+               with_sensor, local.size());
   if (stems.empty())
     fmt::print(
         "           none found: heights are measured from the lowest points of each {} m "

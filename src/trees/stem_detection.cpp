@@ -45,7 +45,8 @@ class ColumnIndex {
 
   const std::vector<Vector3d>& points() const { return points_; }
 
-  /// The horizontal direction from the sensor to point i (unit), zero when unknown.
+  /// The horizontal direction from the sensor to point i (unit); zero when unknown (no or a NaN
+  /// viewpoint) or the point lies within 10 cm of it.
   Vector2d beamOf(std::uint32_t i) const {
     if (viewpoints_.empty()) return Vector2d::Zero();
     const Vector2d beam = points_[i].head<2>() - viewpoints_[i];

@@ -37,6 +37,9 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   // The run's trees.csv against `taiga trees` on its map.las.
   r = test::runTaiga("trees " + run + " --out " + dir.file("offline").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Every point of the run's map knows its keyframe: the DBH fit measures along the beams.
+  EXPECT_NE(r.output.find("residuals along the beams for"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("across the surface (no sensor"), std::string::npos) << r.output;
   const auto online = trees::readTreesCsv(run + "/trees.csv");
   const auto offline = trees::readTreesCsv(dir.file("offline/trees.csv"));
   EXPECT_NEAR(static_cast<double>(online.size()), static_cast<double>(offline.size()), 5.0);
