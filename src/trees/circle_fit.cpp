@@ -189,6 +189,16 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const 
   return fit;
 }
 
+std::optional<CircleFit> fitStemSection(std::span<const Vector2d> points_m, const Vector2d& center_m,
+                                        double radius_m, const CircleFitOptions& options,
+                                        std::span<const Vector2d> beams) {
+  const std::optional<CircleFit> across = refineCircle(points_m, center_m, radius_m, options);
+  if (!across || beams.empty()) return across;
+  const std::optional<CircleFit> along = refineCircle(points_m, center_m, radius_m, options, beams);
+  if (!along || along->arc_deg < 0.8 * across->arc_deg) return across;
+  return along;
+}
+
 std::optional<CircleFit> fitCircleRobust(std::span<const Vector2d> points_m,
                                          const CircleFitOptions& options) {
   const std::size_t n = points_m.size();

@@ -248,7 +248,7 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
   if (lean_rad * kDegPerRad > o.max_lean_deg) return std::nullopt;
 
   // DBH: the band's points with the lean taken out, fitted around the axis; along each point's
-  // beam where the sensor's position is known (refineCircle).
+  // beam where the sensor's position is known (fitStemSection).
   std::vector<Vector2d> upright, beams;
   index.forEachNear(axis.at_breast_height, seed.radius_m + 0.15 + 0.3 * axis.slope.norm(), band_lo,
                     band_hi, [&](const Vector3d& p, std::uint32_t i) {
@@ -256,7 +256,7 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
                       beams.push_back(index.beamOf(i));
                     });
   const std::optional<CircleFit> dbh_fit =
-      refineCircle(upright, axis.at_breast_height, seed.radius_m, fit, beams);
+      fitStemSection(upright, axis.at_breast_height, seed.radius_m, fit, beams);
   const double max_rms_m =
       slices.size() >= o.long_stem_slices ? o.max_fit_rms_m : 2.0 / 3.0 * o.max_fit_rms_m;
   if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > max_rms_m ||

@@ -42,7 +42,11 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   EXPECT_EQ(r.output.find("across the surface (no sensor"), std::string::npos) << r.output;
   const auto online = trees::readTreesCsv(run + "/trees.csv");
   const auto offline = trees::readTreesCsv(dir.file("offline/trees.csv"));
-  EXPECT_NEAR(static_cast<double>(online.size()), static_cast<double>(offline.size()), 5.0);
+  // The final pass reads the keyframe store, `taiga trees` the decimated map.las: stems at the
+  // edge of the checks (12-36 points) tip either way. Measured 173 online against 178 offline,
+  // 175 against 182 since a failed along-beam fit falls back to the fit across (session 42).
+  const double slack = 0.05 * static_cast<double>(offline.size());
+  EXPECT_NEAR(static_cast<double>(online.size()), static_cast<double>(offline.size()), slack);
   // The bound (DBH RMSE <= 0.5 cm) on the stems whose DBH both fits know to 2 cm: a stem
   // seen over 70-100 deg with 10 points came out 7.4 cm offline and 18.4 cm online (1-sigma
   // 8.9 cm), which alone made the RMSE over all stems 0.83 cm (0.48 cm before the NDT change of
@@ -63,7 +67,7 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
         }
         break;
       }
-  EXPECT_GE(matched + 5, offline.size());
+  EXPECT_GE(static_cast<double>(matched) + slack, static_cast<double>(offline.size()));
   EXPECT_GE(certain, matched * 4 / 5);
   EXPECT_LE(std::sqrt(sq / std::max<std::size_t>(1, certain)), 0.005);
 
@@ -75,14 +79,13 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   const auto trees = nlohmann::json::parse(r.output)["trees"];
   SCOPED_TRACE(trees.dump());
   EXPECT_GT(trees["reference"].get<int>(), 60);
-  // Measured 97-98 % detection, 0-2 % commission, DBH RMSE 2.2-2.9 cm (bias -1.0 to -1.7 cm: the
-  // lidar map's stems are slimmer than the true ones, docs/trees.md), position RMSE 1.8-2.3 cm,
-  // before the DBH fit measured range noise along the beams (session 41: on seed 12 DBH RMSE
-  // 1.38 cm, bias -0.35 cm; the bounds are not tightened yet, this seed's figures unmeasured).
+  // Measured on this seed (session 42): detection 97.6 %, commission 0.8 %, DBH RMSE 1.76 cm,
+  // bias -0.83 cm, position RMSE 1.5 cm; the fit across the surface alone (`taiga trees` on
+  // map.las) 2.17 cm and -1.39 cm, and 2.2-2.9 cm, -1.0 to -1.7 cm on seeds 12 and 13.
   EXPECT_GE(trees["recall"].get<double>(), 0.92);
   EXPECT_LE(trees["commission"].get<double>(), 0.05);
-  EXPECT_LE(trees["dbh_rmse_m"].get<double>(), 0.035);
-  EXPECT_LE(std::abs(trees["dbh_bias_m"].get<double>()), 0.025);
+  EXPECT_LE(trees["dbh_rmse_m"].get<double>(), 0.025);
+  EXPECT_LE(std::abs(trees["dbh_bias_m"].get<double>()), 0.012);
   EXPECT_LE(trees["position_rmse_m"].get<double>(), 0.04);
   EXPECT_LE(trees["height_rmse_m"].get<double>(), 4.0);
 }

@@ -57,4 +57,16 @@ std::optional<CircleFit> refineCircle(std::span<const Eigen::Vector2d> points_m,
                                       const CircleFitOptions& options = {},
                                       std::span<const Eigen::Vector2d> beams = {});
 
+/// A stem section's circle from a starting circle: refineCircle across the surface, then, when
+/// `beams` are given, along them, unless that fit lost the views the first one held (its inliers
+/// cover less than 0.8 of the first fit's arc): then the fit across the surface. The along-beam
+/// residual amplifies errors across the beam (views from keyframes that do not quite meet) at
+/// oblique incidence, and a point whose beam misses the circle costs nothing, so on a scattered
+/// section it can escape to a large circle through one view's arc (docs/trees.md, "Where the DBH
+/// error comes from").
+std::optional<CircleFit> fitStemSection(std::span<const Eigen::Vector2d> points_m,
+                                        const Eigen::Vector2d& center_m, double radius_m,
+                                        const CircleFitOptions& options = {},
+                                        std::span<const Eigen::Vector2d> beams = {});
+
 }  // namespace taiga::trees
