@@ -189,8 +189,9 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const 
   return fit;
 }
 
-std::optional<CircleFit> fitStemSection(std::span<const Vector2d> points_m, const Vector2d& center_m,
-                                        double radius_m, const CircleFitOptions& options,
+std::optional<CircleFit> fitStemSection(std::span<const Vector2d> points_m,
+                                        const Vector2d& center_m, double radius_m,
+                                        const CircleFitOptions& options,
                                         std::span<const Vector2d> beams) {
   const std::optional<CircleFit> across = refineCircle(points_m, center_m, radius_m, options);
   if (!across || beams.empty()) return across;

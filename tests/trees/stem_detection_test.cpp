@@ -88,8 +88,8 @@ struct OneSidedStem {
 OneSidedStem oneSidedStem(double sigma_m, unsigned seed) {
   const double facing = -0.5 * std::numbers::pi, half_arc = 70.0 * std::numbers::pi / 180.0;
   OneSidedStem out;
-  out.points_m = test::syntheticForest({{{0.0, 0.0}, 0.24, 0.0, facing - half_arc, facing + half_arc}},
-                                       0.002, seed, false);
+  out.points_m = test::syntheticForest(
+      {{{0.0, 0.0}, 0.24, 0.0, facing - half_arc, facing + half_arc}}, 0.002, seed, false);
   std::mt19937 rng(seed);
   std::normal_distribution<double> range_noise(0.0, sigma_m);
   const Eigen::Vector2d sensor(0.0, -8.0);
@@ -103,9 +103,10 @@ OneSidedStem oneSidedStem(double sigma_m, unsigned seed) {
 }
 
 double dbhOfTheStem(const OneSidedStem& stem, bool with_viewpoints) {
-  const Inventory inventory = takeInventory(
-      stem.points_m, {},
-      with_viewpoints ? std::span<const Eigen::Vector3d>(stem.viewpoints_m) : std::span<const Eigen::Vector3d>());
+  const Inventory inventory =
+      takeInventory(stem.points_m, {},
+                    with_viewpoints ? std::span<const Eigen::Vector3d>(stem.viewpoints_m)
+                                    : std::span<const Eigen::Vector3d>());
   EXPECT_EQ(inventory.stems.size(), 1u);
   return inventory.stems.empty() ? 0.0 : inventory.stems.front().dbh_m;
 }
@@ -117,8 +118,8 @@ TEST(Stems, RangeNoiseOnAOneSidedStemLeavesItsDbhUnbiasedWhenTheViewpointsAreGiv
     for (const double sigma_m : {0.012, 0.035}) {
       const OneSidedStem stem = oneSidedStem(sigma_m, seed);
       const double across_m = dbhOfTheStem(stem, false), along_m = dbhOfTheStem(stem, true);
-      EXPECT_LT(across_m - 0.24, -0.3 * sigma_m) << seed << " " << sigma_m
-                                                 << ": the bias this test is about has gone away";
+      EXPECT_LT(across_m - 0.24, -0.3 * sigma_m)
+          << seed << " " << sigma_m << ": the bias this test is about has gone away";
       EXPECT_NEAR(along_m, 0.24, 0.2 * sigma_m) << seed << " " << sigma_m;
     }
   }
