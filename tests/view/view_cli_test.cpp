@@ -36,10 +36,14 @@ std::size_t tumRows(const std::filesystem::path& path) {
   return rows;
 }
 
-/// tools/viewer-check's report on the page at `url`, its screenshot written to `png`.
-nlohmann::json checkPage(const std::string& url, const std::filesystem::path& png) {
-  const test::TaigaResult r = test::runCommand(
-      fmt::format("node tools/viewer-check/viewer-check.mjs {} {} 60 2>&1", url, png.string()));
+/// tools/viewer-check's report on the page at `url`, its screenshot written to `png`, taken once
+/// the page holds at least `min_keyframes` keyframes.
+nlohmann::json checkPage(const std::string& url, const std::filesystem::path& png,
+                         int min_keyframes = 0) {
+  const test::TaigaResult r =
+      test::runCommand(fmt::format("node tools/viewer-check/viewer-check.mjs {} {} 60 "
+                                   "--min-keyframes {} 2>&1",
+                                   url, png.string(), min_keyframes));
   EXPECT_EQ(r.exit_code, 0) << r.output << " (run scripts/setup.sh)";
   const nlohmann::json report = nlohmann::json::parse(r.output, nullptr, false);
   EXPECT_TRUE(report.is_object()) << r.output;
@@ -110,8 +114,10 @@ TEST(ViewCli, TheViewerFollowsALiveRun) {
     return test::runTaiga(fmt::format("run --live --config {} --out {} --view {}",
                                       config_path.string(), (sim / "live_run").string(), address));
   });
+  // Judged at 6 of the walk's 10 keyframes: at its first 2 the map covered 4 % of the view on
+  // a CI machine where Chromium connected early, 5 % is asked.
   auto page = std::async(std::launch::async, [&] {
-    return checkPage("http://" + address + "/", dir.file("live.png"));
+    return checkPage("http://" + address + "/", dir.file("live.png"), 6);
   });
   std::this_thread::sleep_for(std::chrono::seconds(1));  // until it listens
   // The viewer serves once the first scans arrived, and Chromium may take seconds to start on a
@@ -126,7 +132,7 @@ TEST(ViewCli, TheViewerFollowsALiveRun) {
   expectAPageThatDrewTheMap(report, dir.file("live.png"));
   EXPECT_EQ(report["state"]["mode"], "live");
   EXPECT_GT(report["state"]["poses"].get<int>(), 5);
-  EXPECT_GT(report["state"]["keyframes"].get<int>(), 0);
+  EXPECT_GE(report["state"]["keyframes"].get<int>(), 6);
   EXPECT_GT(report["state"]["scans"].get<int>(), 5);
   EXPECT_GT(report["state"]["graphUpdates"].get<int>(), 0);  // keyframes placed by the graph
 }

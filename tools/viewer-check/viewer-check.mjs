@@ -4,12 +4,16 @@
 // view differ from the background; writes a screenshot. Retries loading until the server is up.
 // With --orbit, it then drags the view around for 5 s as a user would and reports the frames
 // drawn per second, the points shown and the node bytes fetched (bench/viewer.sh).
-// Usage: node viewer-check.mjs URL SCREENSHOT.png [TIMEOUT_S] [--orbit]
+// With --min-keyframes N, a live page is judged once N keyframes arrived, not at its first: how
+// much of the view the map covers must not depend on when Chromium happened to connect.
+// Usage: node viewer-check.mjs URL SCREENSHOT.png [TIMEOUT_S] [--orbit] [--min-keyframes N]
 import { chromium } from "playwright-core";
 
 const [url, screenshot] = process.argv.slice(2, 4);
 const timeoutS = Number(process.argv[4] ?? 60);
 const orbit = process.argv.includes("--orbit");
+const minKeyframesAt = process.argv.indexOf("--min-keyframes");
+const minKeyframes = minKeyframesAt > 0 ? Number(process.argv[minKeyframesAt + 1]) : 0;
 const deadline = Date.now() + timeoutS * 1000;
 
 const browser = await chromium.launch({
@@ -34,6 +38,8 @@ try {
   await page.waitForFunction(() => window.taigaView?.ready === true, null,
                              { timeout: Math.max(deadline - Date.now(), 1000) });
   result.ready = true;
+  await page.waitForFunction((n) => window.taigaView.keyframes >= n, minKeyframes,
+                             { timeout: Math.max(deadline - Date.now(), 1000) });
   await page.waitForFunction(() => window.taigaView.loading === 0, null, { timeout: 20000 });
   await page.waitForTimeout(500);
   result.state = await page.evaluate(() => ({ ...window.taigaView }));
