@@ -41,6 +41,8 @@ nlohmann::json leverArmJson(const pipeline::SelfCalibration& c) {
           {"applied", false},
           {"change_m", asVector(e.correction_m)},
           {"sigma_m", asVector(e.sigma_m)},
+          {"formal_sigma_m", asVector(e.formal_sigma_m)},
+          {"jackknife_sigma_m", asVector(e.jackknife_sigma_m)},
           {"observable_along_body_xyz",
            std::vector<bool>{e.observable(0), e.observable(1), e.observable(2)}},
           {"note",

@@ -77,14 +77,15 @@ LeverArmEstimate estimateLeverArm(const LeverArmInput& in, double max_sigma_m) {
   }
 
   // Weighted least squares; the weights are the residuals' own RMS per kind (positions,
-  // velocities), found by solving twice.
+  // velocities), found by solving twice. Rows [left_out_from, left_out_to) are dropped (jackknife).
   double sigma_p = 0.01, sigma_v = 0.01;
   VectorXd x;
   MatrixXd N;
   Matrix3d held_prior = Matrix3d::Zero();
-  auto solve = [&] {
+  auto solve = [&](Eigen::Index left_out_from = 0, Eigen::Index left_out_to = 0) {
     VectorXd w(rows);
     for (Eigen::Index r = 0; r < rows; ++r) w(r) = (r % 6 < 3) ? 1.0 / sigma_p : 1.0 / sigma_v;
+    w.segment(left_out_from, left_out_to - left_out_from).setZero();
     const MatrixXd Aw = w.asDiagonal() * A;
     N = Aw.transpose() * Aw;
     N.diagonal().array() += 1e-9;  // a flat direction stays where it is
@@ -108,9 +109,29 @@ LeverArmEstimate estimateLeverArm(const LeverArmInput& in, double max_sigma_m) {
   // motion determined.
   MatrixXd unit = MatrixXd::Zero(n, 3);
   unit.topRows<3>().setIdentity();
-  const Matrix3d cov = N.ldlt().solve(unit).topRows<3>();
-  const Eigen::SelfAdjointEigenSolver<Matrix3d> eig(cov);
+  const Matrix3d formal_cov = N.ldlt().solve(unit).topRows<3>();
+  const VectorXd x_all = x;
   LeverArmEstimate e;
+  e.formal_sigma_m = formal_cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  // The formal covariance believes every row independent; the registration's errors follow the
+  // gait and the terrain over seconds. A delete-one-block jackknife over kBlocks stretches of
+  // the walk (Efron & Stein; Kuensch 1989 for dependent data) sees those errors in the spread of
+  // the estimates: var = (B - 1) / B * sum_b (d_b - mean)^2. The larger of the two is reported.
+  constexpr Eigen::Index kBlocks = 8;
+  std::vector<Vector3d> d_blocks;
+  for (Eigen::Index block = 0; block < kBlocks; ++block) {
+    solve(6 * (static_cast<Eigen::Index>(all.size()) * block / kBlocks),
+          6 * (static_cast<Eigen::Index>(all.size()) * (block + 1) / kBlocks));
+    d_blocks.push_back(x.segment<3>(kLever));
+  }
+  Vector3d mean = Vector3d::Zero();
+  for (const Vector3d& d : d_blocks) mean += d / kBlocks;
+  Matrix3d jackknife_cov = Matrix3d::Zero();
+  for (const Vector3d& d : d_blocks)
+    jackknife_cov += (d - mean) * (d - mean).transpose() * (kBlocks - 1.0) / kBlocks;
+  e.jackknife_sigma_m = jackknife_cov.diagonal().cwiseSqrt();
+  const Matrix3d cov = jackknife_cov.trace() > formal_cov.trace() ? jackknife_cov : formal_cov;
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> eig(cov);
   std::vector<Vector3d> held;
   for (int i = 0; i < 3; ++i) {
     if (std::sqrt(std::max(0.0, eig.eigenvalues()(i))) <= max_sigma_m) continue;
@@ -118,9 +139,10 @@ LeverArmEstimate estimateLeverArm(const LeverArmInput& in, double max_sigma_m) {
     held_prior += 1e12 * held.back() * held.back().transpose();  // held at the configured value
   }
   e.observable = axesNotHeld(held);
+  x = x_all;
   if (!held_prior.isZero()) solve();
   e.correction_m = x.segment<3>(kLever);
-  e.sigma_m = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  e.sigma_m = e.formal_sigma_m.cwiseMax(e.jackknife_sigma_m);
   e.accel_bias_mps2 = x.segment<3>(kAccelBias);
   e.position_rms_m = residualRms(0);
   e.velocity_rms_mps = residualRms(3);

@@ -39,8 +39,10 @@ struct Motion {
   }
 };
 
+/// `shift_m`: the lever arm moves by this halfway through (a mount that slipped), from
+/// d_true - shift_m / 2 to d_true + shift_m / 2.
 LeverArmInput simulate(const Motion& m, const Vector3d& d_true, const Vector3d& accel_bias,
-                       unsigned seed) {
+                       unsigned seed, const Vector3d& shift_m = Vector3d::Zero()) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
   auto noise3 = [&](double sigma) -> Vector3d {
@@ -57,7 +59,8 @@ LeverArmInput simulate(const Motion& m, const Vector3d& d_true, const Vector3d& 
   for (double t = 0.5; t < 30.0; t += 0.1) {
     if (std::fmod(t, 7.0) < 0.1) in.chains.emplace_back();  // a scan not registered now and then
     // The registration puts the body where the configured lever arm puts it: p_B + R d.
-    in.chains.back().push_back({t, lie::SE3(m.R(t), m.p(t) + m.R(t) * d_true + noise3(0.002))});
+    const Vector3d d = d_true + (t < 15.0 ? -0.5 : 0.5) * shift_m;
+    in.chains.back().push_back({t, lie::SE3(m.R(t), m.p(t) + m.R(t) * d + noise3(0.002))});
   }
   return in;
 }
@@ -72,6 +75,26 @@ TEST(LeverArm, FindsTheLeverArmWhereTheRigTurnsAboutAllAxes) {
     EXPECT_GT(e.sigma_m.minCoeff(), 0.0);
     EXPECT_LT(e.sigma_m.maxCoeff(), 0.01);
   }
+}
+
+TEST(LeverArm, TheJackknifeAgreesWithTheFormalSigmaOnConsistentData) {
+  const LeverArmEstimate e =
+      estimateLeverArm(simulate(Motion{}, Vector3d(0.02, -0.05, 0.03), Vector3d::Zero(), 5));
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GT(e.jackknife_sigma_m(i), 0.2 * e.formal_sigma_m(i)) << i;
+    EXPECT_LT(e.jackknife_sigma_m(i), 3.0 * e.formal_sigma_m(i)) << i;
+    EXPECT_EQ(e.sigma_m(i), std::max(e.formal_sigma_m(i), e.jackknife_sigma_m(i)));
+  }
+}
+
+TEST(LeverArm, TheJackknifeSeesALeverArmThatChangedAlongTheWay) {
+  // The stretches disagree along x only: the spread of the leave-one-block-out estimates says so.
+  const Vector3d d_true(0.02, -0.05, 0.03);
+  const LeverArmEstimate e =
+      estimateLeverArm(simulate(Motion{}, d_true, Vector3d::Zero(), 3, Vector3d(0.02, 0.0, 0.0)));
+  EXPECT_GT(e.jackknife_sigma_m.x(), 0.002);
+  EXPECT_GT(e.jackknife_sigma_m.x(), 3.0 * e.jackknife_sigma_m.tail<2>().maxCoeff());
+  EXPECT_LT((e.correction_m - d_true).norm(), 0.005);  // the mean of the two
 }
 
 TEST(LeverArm, YawOnlyHoldsTheVerticalComponent) {

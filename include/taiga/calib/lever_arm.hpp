@@ -35,7 +35,11 @@ struct LeverArmInput {
 struct LeverArmEstimate {
   /// Add to the configured translation of T_body_lidar (0 in the directions not observable).
   Eigen::Vector3d correction_m = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sigma_m = Eigen::Vector3d::Zero();  ///< 1-sigma along body x, y, z
+  /// 1-sigma along body x, y, z: the larger of the formal one (rows independent) and a block
+  /// jackknife's (errors correlated over seconds), both kept.
+  Eigen::Vector3d sigma_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d formal_sigma_m = Eigen::Vector3d::Zero(),
+                  jackknife_sigma_m = Eigen::Vector3d::Zero();
   Eigen::Vector3<bool> observable{false, false, false};
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
   double position_rms_m = 0.0, velocity_rms_mps = 0.0;  ///< residuals of (2)
