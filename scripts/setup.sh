@@ -11,6 +11,8 @@ cd "$(dirname "$0")/.."
 packages=(
   # toolchain
   build-essential cmake ninja-build pkg-config git
+  # a compiler cache: rebuilding a fresh clone (CI) recompiles only what changed
+  ccache
   # fuzzing (scripts/fuzz.sh): clang with libFuzzer and the sanitizer runtimes
   clang libclang-rt-14-dev
   # math, configuration, command line, logging
