@@ -46,8 +46,9 @@ nlohmann::json leverArmJson(const pipeline::SelfCalibration& c) {
           {"observable_along_body_xyz",
            std::vector<bool>{e.observable(0), e.observable(1), e.observable(2)}},
           {"note",
-           "not applied to rig.yaml: on registered poses the estimate is biased by 1.5-2.3 cm "
-           "along the vertical even for a perfectly calibrated rig (docs/calibration.md)"}};
+           "not applied to rig.yaml: on registered poses the estimate is off by up to 1.2 cm "
+           "(along the vertical always low, by 0.2-0.5 cm) even for a perfectly calibrated "
+           "simulated rig (docs/calibration.md)"}};
 }
 
 /// The gyro's noise density against the lidar (calib/gyro_noise.hpp), with the residual's

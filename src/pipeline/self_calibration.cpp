@@ -115,8 +115,9 @@ bool settled(const calib::TimeRotationEstimate& e) {
 }
 
 /// The lever arm from the last pass's poses (with the rotation and offset it ran with). Reported,
-/// not applied: on registered poses it is biased by 1.5-2.3 cm along the vertical even for a
-/// perfectly calibrated simulated rig, while on the true poses it is exact (docs/calibration.md).
+/// not applied: on registered poses it is off by up to 1.2 cm (along the vertical always low) even
+/// for a perfectly calibrated simulated rig, while on the true poses it is exact
+/// (docs/calibration.md).
 void estimateLeverArm(PassData& data, double max_sigma_m, SelfCalibration& result) {
   data.lever_arm.bias_hat.gyro_radps = result.last.gyro_bias_radps;
   try {
