@@ -20,10 +20,10 @@ namespace {
 constexpr const char* kPython = "/usr/bin/python3";
 constexpr int kExitNoMatplotlib = 3;  // scripts/plot_eval.py's exit code without matplotlib
 
-// This file is src/eval/plot.cpp in the source tree the library was compiled from.
+// In the source tree the library was compiled from: TAIGA_SOURCE_DIR, which CMakeLists.txt
+// defines for this file (not __FILE__, which the compiler cache makes relative to the tree).
 std::filesystem::path sourceTreeScript() {
-  return std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "scripts" /
-         "plot_eval.py";
+  return std::filesystem::path(TAIGA_SOURCE_DIR) / "scripts" / "plot_eval.py";
 }
 
 std::string readAll(const std::filesystem::path& path) {
