@@ -56,6 +56,7 @@ json treesJson(const EvalReport& report) {
           {"commission", t.commission},
           {"dbh_rmse_m", t.dbh_rmse_m},
           {"dbh_bias_m", t.dbh_bias_m},
+          {"dbh_within_2_sigma", t.dbh_within_2_sigma},
           {"position_rmse_m", t.position_rmse_m},
           {"height_rmse_m", t.height_rmse_m},
           {"height_bias_m", t.height_bias_m},

@@ -1,6 +1,7 @@
 // Text and Markdown renderings of an evaluation.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,10 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
                                             100 * t.commission, t.false_stems, t.estimated)});
     rows.push_back({"DBH error (cm)", fmt::format("rmse {:.2f}  bias {:+.2f}", 100 * t.dbh_rmse_m,
                                                   100 * t.dbh_bias_m)});
+    if (!std::isnan(t.dbh_within_2_sigma))
+      rows.push_back({"DBH error within 2 sigma (%)",
+                      fmt::format("{:.1f} (about 95 if the stated sigma is honest)",
+                                  100 * t.dbh_within_2_sigma)});
     rows.push_back({"Stem position RMSE (cm)", fmt::format("{:.2f}", 100 * t.position_rmse_m)});
     rows.push_back({"Tree height error (m)",
                     fmt::format("rmse {:.2f}  bias {:+.2f}", t.height_rmse_m, t.height_bias_m)});

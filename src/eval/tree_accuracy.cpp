@@ -65,7 +65,7 @@ TreeAccuracy evaluateTrees(const std::vector<trees::TreeRecord>& estimate,
     a.by_distance.push_back(
         {fmt::format("{:.0f}-{:.0f} m from the path", k * step_m, (k + 1) * step_m)});
   double dbh_sq = 0, dbh_sum = 0, pos_sq = 0, height_sq = 0, height_sum = 0;
-  std::size_t heights = 0, overlapping = 0;
+  std::size_t heights = 0, overlapping = 0, with_sigma = 0, within_2_sigma = 0;
   for (std::size_t j = 0; j < reference.size(); ++j) {
     const trees::TreeRecord& ref = reference[j];
     const double distance_m = pathDistance(ref.bh_xy_m, reference_path_m);
@@ -90,6 +90,10 @@ TreeAccuracy evaluateTrees(const std::vector<trees::TreeRecord>& estimate,
     const double dbh_error = est.dbh_m * T.scale - ref.dbh_m;
     dbh_sq += dbh_error * dbh_error;
     dbh_sum += dbh_error;
+    if (est.dbh_sigma_m > 0.0) {  // false for NaN: a file without the column
+      ++with_sigma;
+      if (std::abs(dbh_error) <= 2.0 * est.dbh_sigma_m * T.scale) ++within_2_sigma;
+    }
     const double position_error = (est_xy[i] - ref.bh_xy_m).norm();
     pos_sq += position_error * position_error;
     if (position_error < 0.5 * (est.dbh_m + ref.dbh_m)) ++overlapping;
@@ -116,6 +120,8 @@ TreeAccuracy evaluateTrees(const std::vector<trees::TreeRecord>& estimate,
   a.commission = a.estimated > 0 ? static_cast<double>(a.false_stems) / a.estimated : kNaN;
   a.dbh_rmse_m = a.detected > 0 ? std::sqrt(dbh_sq / n) : kNaN;
   a.dbh_bias_m = a.detected > 0 ? dbh_sum / n : kNaN;
+  a.dbh_within_2_sigma =
+      with_sigma > 0 ? static_cast<double>(within_2_sigma) / static_cast<double>(with_sigma) : kNaN;
   a.position_rmse_m = a.detected > 0 ? std::sqrt(pos_sq / n) : kNaN;
   a.height_rmse_m = heights > 0 ? std::sqrt(height_sq / static_cast<double>(heights)) : kNaN;
   a.height_bias_m = heights > 0 ? height_sum / static_cast<double>(heights) : kNaN;

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -198,6 +199,89 @@ std::optional<CircleFit> fitStemSection(std::span<const Vector2d> points_m,
   const std::optional<CircleFit> along = refineCircle(points_m, center_m, radius_m, options, beams);
   if (!along || along->arc_deg < 0.8 * across->arc_deg) return across;
   return along;
+}
+
+namespace {
+
+// Each point's block for the jackknife: the points sorted by the direction they were seen from
+// (their beam's azimuth; where the beam is unknown, their azimuth around the centre), starting
+// after the widest gap between directions, cut into `blocks` runs of about equal count, each cut
+// moved to the widest gap within half a block of its place. Points of one keyframe share a
+// direction, so a block holds whole views (a block that splits a view keeps its placement).
+std::vector<int> viewBlocks(std::span<const Vector2d> points_m, std::span<const Vector2d> beams,
+                            const Vector2d& center_m, int blocks) {
+  const std::size_t n = points_m.size();
+  std::vector<double> azimuth(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool known = i < beams.size() && beams[i].squaredNorm() > 0.0;
+    const Vector2d d = known ? beams[i] : Vector2d(points_m[i] - center_m);
+    azimuth[i] = std::atan2(d.y(), d.x());
+  }
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return azimuth[a] < azimuth[b]; });
+  std::size_t first = 0;  // the run starts after the widest gap (circularly)
+  double widest = azimuth[order[0]] + 2.0 * std::numbers::pi - azimuth[order[n - 1]];
+  for (std::size_t k = 1; k < n; ++k)
+    if (azimuth[order[k]] - azimuth[order[k - 1]] > widest) {
+      widest = azimuth[order[k]] - azimuth[order[k - 1]];
+      first = k;
+    }
+  auto gapBefore = [&](std::size_t k) {  // k-th in the run, 1 .. n-1
+    const double a = azimuth[order[(first + k) % n]], b = azimuth[order[(first + k - 1) % n]];
+    return a >= b ? a - b : a + 2.0 * std::numbers::pi - b;
+  };
+  std::vector<std::size_t> cuts{0};
+  const std::size_t half = std::max<std::size_t>(1, n / (2 * static_cast<std::size_t>(blocks)));
+  for (int c = 1; c < blocks; ++c) {
+    const std::size_t at = static_cast<std::size_t>(c) * n / static_cast<std::size_t>(blocks);
+    std::size_t best = at;
+    for (std::size_t k = std::max(cuts.back() + 1, at - std::min(at, half));
+         k <= std::min(n - 1, at + half); ++k)
+      if (gapBefore(k) > gapBefore(best)) best = k;
+    cuts.push_back(std::max(best, cuts.back() + 1));
+  }
+  cuts.push_back(n);
+  std::vector<int> block(n);
+  for (int c = 0; c < blocks; ++c)
+    for (std::size_t k = cuts[static_cast<std::size_t>(c)];
+         k < std::min(n, cuts[static_cast<std::size_t>(c) + 1]); ++k)
+      block[order[(first + k) % n]] = c;
+  return block;
+}
+
+}  // namespace
+
+double viewJackknifeSigmaRadius(std::span<const Vector2d> points_m,
+                                std::span<const Vector2d> beams, const CircleFit& fit,
+                                const Vector2d& start_center_m, double start_radius_m,
+                                const CircleFitOptions& options) {
+  constexpr int kBlocks = 8;
+  if (points_m.size() < 2 * kBlocks) return 0.0;
+  const std::vector<int> block = viewBlocks(points_m, beams, fit.center_m, kBlocks);
+  std::vector<double> radii_m;
+  std::vector<Vector2d> kept_points, kept_beams;
+  for (int left_out = 0; left_out < kBlocks; ++left_out) {
+    kept_points.clear();
+    kept_beams.clear();
+    for (std::size_t i = 0; i < points_m.size(); ++i) {
+      if (block[i] == left_out) continue;
+      kept_points.push_back(points_m[i]);
+      if (!beams.empty()) kept_beams.push_back(beams[i]);
+    }
+    const std::optional<CircleFit> refit =
+        fitStemSection(kept_points, start_center_m, start_radius_m, options, kept_beams);
+    if (refit) radii_m.push_back(refit->radius_m);
+  }
+  if (radii_m.size() < 3) return 0.0;
+  // Delete-one-block jackknife: sqrt((g-1)/g sum (r_k - mean)^2) over the g refits.
+  const auto g = static_cast<double>(radii_m.size());
+  double mean_m = 0.0;
+  for (const double r : radii_m) mean_m += r / g;
+  double sum_sq = 0.0;
+  for (const double r : radii_m) sum_sq += (r - mean_m) * (r - mean_m);
+  return std::sqrt((g - 1.0) / g * sum_sq);
 }
 
 std::optional<CircleFit> fitCircleRobust(std::span<const Vector2d> points_m,

@@ -116,6 +116,51 @@ TEST(CircleFit, AScatteredSectionKeepsTheFitAcrossItsSurface) {
   EXPECT_EQ(section->radius_m, across->radius_m);
 }
 
+// A stem seen from six keyframes 5 m away whose placements disagree (each view's arc moved by 1 cm
+// RMS per axis, the map's placement error on `typical` walks): the arcs' points are not
+// independent, so the formal sigma, shrinking with their number, is far too small; the jackknife
+// over blocks of views is not. Without the beams it blocks by azimuth around the centre.
+TEST(CircleFit, TheViewJackknifeSeesViewsThatDoNotMeet) {
+  int formal_covers = 0, jackknife_covers = 0, trials = 0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> shift(0.0, 0.01);
+    const double r = 0.12;
+    std::vector<Vector2d> points, beams;
+    for (int view = 0; view < 6; ++view) {
+      const double facing = 2.0 * std::numbers::pi * view / 6.0;
+      const Vector2d sensor = 5.0 * Vector2d(std::cos(facing), std::sin(facing));
+      const Vector2d offset(shift(rng), shift(rng));
+      for (const Vector2d& p : arc({0, 0}, r, facing - 1.0, facing + 1.0, 60, 0.004, rng)) {
+        points.push_back(p + offset);
+        beams.push_back((p - sensor).normalized());
+      }
+    }
+    const auto fit = fitStemSection(points, {0.01, -0.01}, 0.11, {}, beams);
+    ASSERT_TRUE(fit) << seed;
+    const double jackknife =
+        viewJackknifeSigmaRadius(points, beams, *fit, {0.01, -0.01}, 0.11);
+    const double error = std::abs(fit->radius_m - r);
+    ++trials;
+    formal_covers += error <= 2.0 * fit->sigma_radius_m;
+    jackknife_covers += error <= 2.0 * std::max(fit->sigma_radius_m, jackknife);
+  }
+  EXPECT_LE(formal_covers, trials / 2);
+  EXPECT_GE(jackknife_covers, trials * 17 / 20);
+}
+
+TEST(CircleFit, TheViewJackknifeAgreesWithTheFormalSigmaOnOneRoundSurface) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    std::mt19937 rng(seed);
+    const std::vector<Vector2d> points = arc({0, 0}, 0.12, 0.0, 6.2, 360, 0.004, rng);
+    const auto fit = fitStemSection(points, {0.01, -0.01}, 0.11);
+    ASSERT_TRUE(fit) << seed;
+    const double jackknife = viewJackknifeSigmaRadius(points, {}, *fit, {0.01, -0.01}, 0.11);
+    EXPECT_GT(jackknife, 0.3 * fit->sigma_radius_m) << seed;
+    EXPECT_LT(jackknife, 3.0 * fit->sigma_radius_m) << seed;
+  }
+}
+
 TEST(CircleFit, RefusesWhatHasNoCircleInTheRadiusRange) {
   std::mt19937 rng(4);
   // A straight line (a log's edge, a wall) and a circle larger than allowed.

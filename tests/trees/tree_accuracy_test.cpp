@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 namespace taiga::eval {
 namespace {
 
@@ -37,6 +40,22 @@ TEST(TreeAccuracy, CountsDetectionsCommissionAndErrorsInTheReferenceFrame) {
   EXPECT_EQ(a.missed_ids[0], 4);
   EXPECT_EQ(a.by_dbh[1].reference, 2u);  // 20-30 cm: trees 0 and 1
   EXPECT_EQ(a.by_dbh[1].detected, 2u);
+  EXPECT_TRUE(std::isnan(a.dbh_within_2_sigma));  // no stem states a sigma
+}
+
+TEST(TreeAccuracy, CountsTheDbhErrorsWithinTwiceTheirStatedSigma) {
+  const std::vector<trees::TreeRecord> reference{tree(0, 0, 2, 0.20), tree(1, 5, -3, 0.30),
+                                                 tree(2, 10, 3, 0.25)};
+  // DBH errors +1, -1 and +1 cm; stated sigmas 0.6 cm (within 2), 0.4 cm (not), none.
+  std::vector<trees::TreeRecord> estimate{tree(10, 0, 2, 0.21), tree(11, 5, -3, 0.29),
+                                          tree(12, 10, 3, 0.26)};
+  estimate[0].dbh_sigma_m = 0.006;
+  estimate[1].dbh_sigma_m = 0.004;
+  estimate[2].dbh_sigma_m = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Eigen::Vector3d> path{{-5, 0, 0}, {20, 0, 0}};
+  const TreeAccuracy a = evaluateTrees(estimate, reference, AlignmentTransform{}, path, {});
+  ASSERT_EQ(a.detected, 3u);
+  EXPECT_NEAR(a.dbh_within_2_sigma, 0.5, 1e-12);  // of the two that state one
 }
 
 }  // namespace

@@ -47,11 +47,12 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   // 175 against 182 since a failed along-beam fit falls back to the fit across (session 42).
   const double slack = 0.05 * static_cast<double>(offline.size());
   EXPECT_NEAR(static_cast<double>(online.size()), static_cast<double>(offline.size()), slack);
-  // The issue's bound (DBH RMSE <= 0.5 cm) on the stems whose DBH both fits know to 2 cm: a stem
+  // The issue's bound (DBH RMSE <= 0.5 cm) on the stems whose DBH both fits know to 2.5 cm: a stem
   // seen over 70-100 deg with 10 points came out 7.4 cm offline and 18.4 cm online (1-sigma
   // 8.9 cm), which alone made the RMSE over all stems 0.83 cm (0.48 cm before the NDT change of
   // session 40; 0.03-0.05 cm on the others). Every stem must agree within 3x the two fits'
-  // combined 1-sigma plus 0.5 cm.
+  // combined 1-sigma plus 0.5 cm. Since the sigma includes the view jackknife (session 44) fewer
+  // stems claim 2.5 cm: 117 of 175 (their RMSE 0.09 cm); with the formal sigma alone over 4/5.
   double sq = 0.0;
   std::size_t matched = 0, certain = 0;
   for (const auto& a : offline)
@@ -61,14 +62,14 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
         ++matched;
         EXPECT_LE(std::abs(difference_m), 3.0 * std::hypot(a.dbh_sigma_m, b.dbh_sigma_m) + 0.005)
             << "stem at " << a.bh_xy_m.transpose();
-        if (a.dbh_sigma_m < 0.02 && b.dbh_sigma_m < 0.02) {
+        if (a.dbh_sigma_m < 0.025 && b.dbh_sigma_m < 0.025) {
           sq += difference_m * difference_m;
           ++certain;
         }
         break;
       }
   EXPECT_GE(static_cast<double>(matched) + slack, static_cast<double>(offline.size()));
-  EXPECT_GE(certain, matched * 4 / 5);
+  EXPECT_GE(certain, matched * 3 / 5);
   EXPECT_LE(std::sqrt(sq / std::max<std::size_t>(1, certain)), 0.005);
 
   r = test::runTaiga("eval --est " + run + "/trajectory.tum --ref " + rec +
@@ -88,6 +89,10 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   EXPECT_LE(std::abs(trees["dbh_bias_m"].get<double>()), 0.012);
   EXPECT_LE(trees["position_rmse_m"].get<double>(), 0.04);
   EXPECT_LE(trees["height_rmse_m"].get<double>(), 4.0);
+  // The stated DBH sigma: 73 % of the errors within 2 sigma (session 44; the formal sigma alone
+  // covered 26-36 % on seeds 12 and 13). Not 95 %: the map's shrink (issue 25) biases every stem
+  // alike, which no resampling of one stem's points can see (docs/trees.md, "DBH sigma").
+  EXPECT_GE(trees["dbh_within_2_sigma"].get<double>(), 0.6);
 }
 
 }  // namespace

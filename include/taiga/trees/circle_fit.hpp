@@ -69,4 +69,16 @@ std::optional<CircleFit> fitStemSection(std::span<const Eigen::Vector2d> points_
                                         const CircleFitOptions& options = {},
                                         std::span<const Eigen::Vector2d> beams = {});
 
+/// The 1-sigma of fitStemSection's radius from a delete-one-block jackknife over the directions
+/// the points were seen from: sorted by their beam's azimuth (or, where unknown, by their azimuth
+/// around `fit`'s centre) and cut into 8 blocks of equal count; the section is fitted again (from
+/// the same start) without each block, sigma = sqrt((g-1)/g sum (r_k - mean r)^2) over the g
+/// refits. It sees what the formal sigma (points independent) cannot: views from keyframes that
+/// do not quite meet, which move whole arcs, and a section that is not round. 0 when there are
+/// fewer than 16 points or 3 refits.
+double viewJackknifeSigmaRadius(std::span<const Eigen::Vector2d> points_m,
+                                std::span<const Eigen::Vector2d> beams, const CircleFit& fit,
+                                const Eigen::Vector2d& start_center_m, double start_radius_m,
+                                const CircleFitOptions& options = {});
+
 }  // namespace taiga::trees
