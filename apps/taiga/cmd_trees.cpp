@@ -166,8 +166,12 @@ int runTrees(const TreesOptions& options) {
                "a map without point times)\n");
   else
     fmt::print("DBH fit    residuals along the beams for {} of {} points (the sensor at their "
-               "keyframe), across the surface for the others\n",
-               with_sensor, local.size());
+               "keyframe), across the surface for the others; kept along the beams for {} of {} "
+               "stems (the others' views do not meet well enough: docs/trees.md)\n",
+               with_sensor, local.size(),
+               std::count_if(stems.begin(), stems.end(),
+                             [](const trees::Stem& s) { return s.dbh_along_beams; }),
+               stems.size());
   if (stems.empty())
     fmt::print(
         "           none found: heights are measured from the lowest points of each {} m "

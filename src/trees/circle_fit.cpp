@@ -176,6 +176,7 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const 
     const double across_m = (points_m[i] - circle.center_m).norm() - circle.radius_m;
     inlier_sq += across_m * across_m;
     ++fit.inliers;
+    fit.along_beams = fit.along_beams || beamOf(i) != nullptr;
   }
   if (fit.inliers == 0) return std::nullopt;
   fit.rms_m = std::sqrt(inlier_sq / static_cast<double>(fit.inliers));

@@ -280,6 +280,7 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
   stem.points = dbh_fit->inliers;
   stem.fit_rms_m = dbh_fit->rms_m;
   stem.arc_deg = dbh_fit->arc_deg;
+  stem.dbh_along_beams = dbh_fit->along_beams;
   stem.slices = slices.size();
   for (const Slice& s : slices) stem.top_slice_m = std::max(stem.top_slice_m, s.h_m);
   stem.quality = stem.fit_rms_m > 0.02 || axis.rms_m > 0.03 ? StemQuality::kPoor

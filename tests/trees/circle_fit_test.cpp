@@ -73,6 +73,10 @@ TEST(CircleFit, RangeNoiseAlongTheBeamsLeavesTheRadiusUnbiasedWhenTheBeamsAreGiv
     across_sum_m += across->radius_m - kRadius_m;
     along_sum_m += along->radius_m - kRadius_m;
     EXPECT_LT(along->rms_m, 0.02) << "the RMS stays the scatter across the surface";
+    EXPECT_TRUE(along->along_beams);
+    EXPECT_FALSE(across->along_beams);
+    const std::vector<Vector2d> unknown(beams.size(), Vector2d::Zero());  // no sensor positions
+    EXPECT_FALSE(refineCircle(points, center, kRadius_m, {}, unknown)->along_beams);
   }
   EXPECT_LT(across_sum_m / kTrials, -0.004) << "the bias this test is about has gone away";
   EXPECT_NEAR(along_sum_m / kTrials, 0.0, 0.0015);

@@ -36,6 +36,7 @@ struct CircleFit {
   double densest_share = 1.0;
   double sigma_radius_m = 0.0;  ///< 1-sigma of the radius from the weighted normal equations
   double sigma_center_m = 0.0;  ///< 1-sigma of the centre (the larger axis of its ellipse)
+  bool along_beams = false;     ///< an inlier's residual was measured along its beam
 };
 
 /// The fit to `points_m` (x, y), or nothing when no circle within the radius range has at least

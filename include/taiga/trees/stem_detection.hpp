@@ -72,6 +72,7 @@ struct Stem {
   double fit_rms_m = 0.0;
   double arc_deg = 0.0;
   std::size_t slices = 0;    ///< consistent slices along the stem
+  bool dbh_along_beams = false;  ///< the DBH fit kept its residuals along the beams (circle_fit.hpp)
   double top_slice_m = 0.0;  ///< height of the highest consistent slice above the ground
   StemQuality quality = StemQuality::kGood;
 
