@@ -162,16 +162,18 @@ int runTrees(const TreesOptions& options) {
   const auto with_sensor = std::count_if(viewpoints_m.begin(), viewpoints_m.end(),
                                          [](const Eigen::Vector3d& v) { return v.allFinite(); });
   if (with_sensor == 0)
-    fmt::print("DBH fit    residuals across the surface (no sensor positions: not a taiga run, or "
-               "a map without point times)\n");
+    fmt::print(
+        "DBH fit    residuals across the surface (no sensor positions: not a taiga run, or "
+        "a map without point times)\n");
   else
-    fmt::print("DBH fit    residuals along the beams for {} of {} points (the sensor at their "
-               "keyframe), across the surface for the others; kept along the beams for {} of {} "
-               "stems (the others' views do not meet well enough: docs/trees.md)\n",
-               with_sensor, local.size(),
-               std::count_if(stems.begin(), stems.end(),
-                             [](const trees::Stem& s) { return s.dbh_along_beams; }),
-               stems.size());
+    fmt::print(
+        "DBH fit    residuals along the beams for {} of {} points (the sensor at their "
+        "keyframe), across the surface for the others; kept along the beams for {} of {} "
+        "stems (the others' views do not meet well enough: docs/trees.md)\n",
+        with_sensor, local.size(),
+        std::count_if(stems.begin(), stems.end(),
+                      [](const trees::Stem& s) { return s.dbh_along_beams; }),
+        stems.size());
   if (stems.empty())
     fmt::print(
         "           none found: heights are measured from the lowest points of each {} m "

@@ -254,10 +254,9 @@ std::vector<int> viewBlocks(std::span<const Vector2d> points_m, std::span<const 
 
 }  // namespace
 
-double viewJackknifeSigmaRadius(std::span<const Vector2d> points_m,
-                                std::span<const Vector2d> beams, const CircleFit& fit,
-                                const Vector2d& start_center_m, double start_radius_m,
-                                const CircleFitOptions& options) {
+double viewJackknifeSigmaRadius(std::span<const Vector2d> points_m, std::span<const Vector2d> beams,
+                                const CircleFit& fit, const Vector2d& start_center_m,
+                                double start_radius_m, const CircleFitOptions& options) {
   constexpr int kBlocks = 8;
   if (points_m.size() < 2 * kBlocks) return 0.0;
   const std::vector<int> block = viewBlocks(points_m, beams, fit.center_m, kBlocks);

@@ -268,8 +268,8 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
   if (stem.dbh_m < o.min_dbh_m || stem.dbh_m > o.max_dbh_m) return std::nullopt;
   // The formal sigma treats the band's points as independent; views that do not quite meet move
   // whole arcs, which the view jackknife sees (circle_fit.hpp).
-  const double jackknife_sigma_m = viewJackknifeSigmaRadius(
-      upright, beams, *dbh_fit, axis.at_breast_height, seed.radius_m, fit);
+  const double jackknife_sigma_m =
+      viewJackknifeSigmaRadius(upright, beams, *dbh_fit, axis.at_breast_height, seed.radius_m, fit);
   stem.dbh_sigma_m = 2.0 * std::max(dbh_fit->sigma_radius_m, jackknife_sigma_m) * lean_scale;
   stem.ground_z_m = terrain.heightAt(dbh_fit->center_m.x(), dbh_fit->center_m.y());
   stem.position_m = Vector3d(dbh_fit->center_m.x(), dbh_fit->center_m.y(), stem.ground_z_m + bh);

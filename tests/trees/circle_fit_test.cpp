@@ -142,8 +142,7 @@ TEST(CircleFit, TheViewJackknifeSeesViewsThatDoNotMeet) {
     }
     const auto fit = fitStemSection(points, {0.01, -0.01}, 0.11, {}, beams);
     ASSERT_TRUE(fit) << seed;
-    const double jackknife =
-        viewJackknifeSigmaRadius(points, beams, *fit, {0.01, -0.01}, 0.11);
+    const double jackknife = viewJackknifeSigmaRadius(points, beams, *fit, {0.01, -0.01}, 0.11);
     const double error = std::abs(fit->radius_m - r);
     ++trials;
     formal_covers += error <= 2.0 * fit->sigma_radius_m;

@@ -45,9 +45,9 @@ TEST(TreesScenario, AHandheldWalkFindsTheStemsAndTheirDbhOnlineAsOffline) {
   const std::size_t kept_at = r.output.find("kept along the beams for ");
   ASSERT_NE(kept_at, std::string::npos) << r.output;
   int along = 0, stems = 0;
-  ASSERT_EQ(std::sscanf(r.output.c_str() + kept_at, "kept along the beams for %d of %d", &along,
-                        &stems),
-            2);
+  ASSERT_EQ(
+      std::sscanf(r.output.c_str() + kept_at, "kept along the beams for %d of %d", &along, &stems),
+      2);
   EXPECT_GE(along, stems * 2 / 3) << r.output;
   const auto online = trees::readTreesCsv(run + "/trees.csv");
   const auto offline = trees::readTreesCsv(dir.file("offline/trees.csv"));

@@ -45,7 +45,7 @@ struct TreeAccuracy {
   std::size_t estimated = 0;  ///< detected stems in the area
   std::size_t false_stems = 0;
   double recall = 0.0, commission = 0.0;
-  double dbh_rmse_m = 0.0, dbh_bias_m = 0.0;        ///< over the matched counted trees, est - ref
+  double dbh_rmse_m = 0.0, dbh_bias_m = 0.0;  ///< over the matched counted trees, est - ref
   /// Share of the matched trees that state a DBH 1-sigma whose error is within 2 of it (an honest
   /// sigma: about 0.95); NaN when no estimated tree states one.
   double dbh_within_2_sigma = 0.0;

@@ -71,9 +71,9 @@ struct Stem {
   std::size_t points = 0;                                ///< inliers of the DBH fit
   double fit_rms_m = 0.0;
   double arc_deg = 0.0;
-  std::size_t slices = 0;    ///< consistent slices along the stem
-  bool dbh_along_beams = false;  ///< the DBH fit kept its residuals along the beams (circle_fit.hpp)
-  double top_slice_m = 0.0;  ///< height of the highest consistent slice above the ground
+  std::size_t slices = 0;        ///< consistent slices along the stem
+  bool dbh_along_beams = false;  ///< the DBH fit's residuals were along the beams
+  double top_slice_m = 0.0;      ///< height of the highest consistent slice above the ground
   StemQuality quality = StemQuality::kGood;
 
   /// The axis at height h above the ground (x, y).
