@@ -52,28 +52,37 @@ Eigen::Vector3d roundOffset(const std::vector<Eigen::Vector3d>& points_m) {
   return Eigen::Vector3d::Zero();
 }
 
-// The sensor position of each point of a run's map.las (local coordinates, like the points):
-// its keyframe's, the first keyframe stamped at or after the point's time (a keyframe carries
-// its scan's end time). Empty when the map has no point times or the run no keyframes.tum; NaN
-// (unknown: that point's residual stays across the surface) for a time no keyframe's scan can
+// The sensor positions of a run's map.las (local coordinates, like the points): the keyframes',
+// and for each point the first keyframe stamped at or after the point's time (a keyframe carries
+// its scan's end time). None when the map has no point times or the run no keyframes.tum;
+// unknown (that point's residual stays across the surface) for a time no keyframe's scan can
 // hold, e.g. the zeros of a recording without per-point times.
-std::vector<Eigen::Vector3d> keyframeViewpoints(const fs::path& run_dir, const PointCloud& map,
-                                                const Eigen::Vector3d& offset_m) {
+struct KeyframeViewpoints {
+  std::vector<Eigen::Vector3d> positions_m;
+  std::vector<std::uint32_t> of_point;
+  trees::Viewpoints view() const { return {positions_m, of_point}; }
+};
+KeyframeViewpoints keyframeViewpoints(const fs::path& run_dir, const PointCloud& map,
+                                      const Eigen::Vector3d& offset_m) {
   const fs::path keyframes_tum = run_dir / "keyframes.tum";
   if (!map.hasTimes() || !fs::exists(keyframes_tum)) return {};
   const Trajectory keyframes = io::readTum(keyframes_tum);
   if (keyframes.empty()) return {};
-  std::vector<Eigen::Vector3d> viewpoints_m(map.size());
+  KeyframeViewpoints viewpoints;
+  for (const StampedPose& k : keyframes)
+    viewpoints.positions_m.push_back(k.pose.translation() - offset_m);
+  viewpoints.of_point.resize(map.size());
   for (std::size_t i = 0; i < map.size(); ++i) {
     const auto after =
         std::lower_bound(keyframes.begin(), keyframes.end(), map.times_s[i],
                          [](const StampedPose& k, double t_s) { return k.t_s < t_s; });
     constexpr double kLongestScan_s = 1.0;
-    viewpoints_m[i] = after != keyframes.end() && after->t_s - map.times_s[i] <= kLongestScan_s
-                          ? Eigen::Vector3d(after->pose.translation() - offset_m)
-                          : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    viewpoints.of_point[i] =
+        after != keyframes.end() && after->t_s - map.times_s[i] <= kLongestScan_s
+            ? static_cast<std::uint32_t>(after - keyframes.begin())
+            : trees::Viewpoints::kUnknown;
   }
-  return viewpoints_m;
+  return viewpoints;
 }
 
 int runTrees(const TreesOptions& options) {
@@ -118,10 +127,10 @@ int runTrees(const TreesOptions& options) {
   io_options.stems.breast_height_m = options.breast_height_m;
   io_options.stems.max_fit_rms_m = options.max_fit_rms_m;
   // A run's map knows where its sensor was: the DBH fit measures range noise along the beams.
-  const std::vector<Eigen::Vector3d> viewpoints_m = run_dir && options.epsg == 0
-                                                        ? keyframeViewpoints(input, cloud, offset_m)
-                                                        : std::vector<Eigen::Vector3d>{};
-  const trees::Inventory inventory = trees::takeInventory(local, io_options, viewpoints_m);
+  const KeyframeViewpoints viewpoints = run_dir && options.epsg == 0
+                                            ? keyframeViewpoints(input, cloud, offset_m)
+                                            : KeyframeViewpoints{};
+  const trees::Inventory inventory = trees::takeInventory(local, io_options, viewpoints.view());
   const std::vector<trees::Stem>& stems = inventory.stems;
 
   trees::writeTreesCsv(out / "trees.csv", stems, offset_m, grid);
@@ -159,8 +168,9 @@ int runTrees(const TreesOptions& options) {
   fmt::print("stems      {} ({} good, {} seen from one side, {} poor){}\n", stems.size(), good,
              partial, stems.size() - good - partial,
              grid ? fmt::format("; in EPSG:{}", grid->epsg) : "");
-  const auto with_sensor = std::count_if(viewpoints_m.begin(), viewpoints_m.end(),
-                                         [](const Eigen::Vector3d& v) { return v.allFinite(); });
+  const auto with_sensor =
+      std::count_if(viewpoints.of_point.begin(), viewpoints.of_point.end(),
+                    [](std::uint32_t k) { return k != trees::Viewpoints::kUnknown; });
   if (with_sensor == 0)
     fmt::print(
         "DBH fit    residuals across the surface (no sensor positions: not a taiga run, or "

@@ -100,18 +100,21 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
     crop_m = std::max(crop_m, distanceXy(k.T_map_body.translation(), center));
   crop_m += kCropMargin_m;
 
-  std::vector<Eigen::Vector3d> points_m, viewpoints_m;
+  std::vector<Eigen::Vector3d> points_m, sensors_m;
+  std::vector<std::uint32_t> sensor_of;
   for (const Keyframe& k : all) {
     if (nearestFresh(k.T_map_body.translation()) > kRegionKeyframes_m) continue;
+    sensors_m.push_back(k.T_map_body.translation());
     for (const Eigen::Vector3d& p_body : store_.load(k.id).positions) {
       const Eigen::Vector3d p = k.T_map_body * p_body;
       if (distanceXy(p, center) > crop_m) continue;
       points_m.push_back(p);
-      viewpoints_m.push_back(k.T_map_body.translation());
+      sensor_of.push_back(static_cast<std::uint32_t>(sensors_m.size() - 1));
     }
   }
   if (points_m.empty()) return;
-  const trees::Inventory inventory = trees::takeInventory(points_m, {}, viewpoints_m);
+  const trees::Inventory inventory =
+      trees::takeInventory(points_m, {}, trees::Viewpoints{sensors_m, sensor_of});
 
   for (const trees::Stem& stem : inventory.stems) {
     const bool seen_here = nearestFresh(stem.position_m) <= kSeen_m;
@@ -146,14 +149,18 @@ std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
   // The final list: one inventory of the whole map on the graph's final poses, the same as
   // `taiga trees RUN` on map.las. The incremental list saw each stem only from the keyframes
   // around it at the time, on live poses (docs/trees.md, "Online").
-  std::vector<Eigen::Vector3d> points_m, viewpoints_m;
-  for (std::uint64_t id = 0; id < final_T_map_body.size() && id < store_.size(); ++id)
+  std::vector<Eigen::Vector3d> points_m, sensors_m;
+  std::vector<std::uint32_t> sensor_of;
+  for (std::uint64_t id = 0; id < final_T_map_body.size() && id < store_.size(); ++id) {
+    sensors_m.push_back(final_T_map_body[id].translation());
     for (const Eigen::Vector3d& p_body : store_.load(id).positions) {
       points_m.push_back(final_T_map_body[id] * p_body);
-      viewpoints_m.push_back(final_T_map_body[id].translation());
+      sensor_of.push_back(static_cast<std::uint32_t>(sensors_m.size() - 1));
     }
+  }
   try {
-    const trees::Inventory inventory = trees::takeInventory(points_m, {}, viewpoints_m);
+    const trees::Inventory inventory =
+        trees::takeInventory(points_m, {}, trees::Viewpoints{sensors_m, sensor_of});
     writeCsv(inventory.stems);
     return inventory.stems.size();
   } catch (const InputError& e) {  // no points, or a map too large for one terrain grid

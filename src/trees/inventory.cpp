@@ -6,10 +6,10 @@
 namespace taiga::trees {
 
 Inventory takeInventory(std::span<const Eigen::Vector3d> points_m, const InventoryOptions& options,
-                        std::span<const Eigen::Vector3d> viewpoints_m) {
+                        const Viewpoints& viewpoints) {
   Inventory inventory;
   inventory.terrain = buildTerrainModel(points_m, options.terrain);
-  inventory.stems = detectStems(points_m, inventory.terrain, options.stems, viewpoints_m);
+  inventory.stems = detectStems(points_m, inventory.terrain, options.stems, viewpoints);
   return inventory;
 }
 

@@ -304,9 +304,18 @@ std::string qualityName(StemQuality quality) {
 }
 
 std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainModel& terrain,
-                              const StemOptions& o, std::span<const Vector3d> viewpoints_m) {
-  if (!viewpoints_m.empty() && viewpoints_m.size() != points_m.size())
-    throw std::invalid_argument("detectStems: viewpoints_m must be empty or one per point");
+                              const StemOptions& o, const Viewpoints& viewpoints) {
+  const std::span<const std::uint32_t> viewpoint_of = viewpoints.of_point;
+  if (!viewpoint_of.empty() && viewpoint_of.size() != points_m.size())
+    throw std::invalid_argument("detectStems: viewpoints must be empty or one per point");
+  for (const std::uint32_t k : viewpoint_of)
+    if (k != Viewpoints::kUnknown && k >= viewpoints.positions_m.size())
+      throw std::invalid_argument("detectStems: a point's viewpoint index is out of range");
+  const auto viewpointXy = [&](std::size_t i) -> Vector2d {
+    const std::uint32_t k = viewpoint_of[i];
+    return k == Viewpoints::kUnknown ? Vector2d::Constant(std::nan(""))
+                                     : Vector2d(viewpoints.positions_m[k].head<2>());
+  };
   const double bh = o.breast_height_m;
   const double band_lo = bh - o.dbh_band_half_m, band_hi = bh + o.dbh_band_half_m;
   std::vector<Vector3d> slab;
@@ -319,7 +328,7 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
     const double h = p.z() - terrain.heightAt(p.x(), p.y());
     if (h >= o.lowest_slice_m && h < o.highest_slice_m) {
       slab.emplace_back(p.x(), p.y(), h);
-      if (!viewpoints_m.empty()) slab_viewpoints.push_back(viewpoints_m[i].head<2>());
+      if (!viewpoint_of.empty()) slab_viewpoints.push_back(viewpointXy(i));
     }
     if (h >= band_lo && h < band_hi) band.push_back(p.head<2>());
     const auto key = cellKey(static_cast<std::int64_t>(std::floor(p.x() / kCanopyPixel_m)),

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <numbers>
+#include <stdexcept>
 
 #include "forest_fixture.hpp"
 #include "taiga/core/errors.hpp"
@@ -81,9 +82,11 @@ TEST(Stems, PointsAreLabelledGroundStemOrOther) {
 }
 
 // A stem seen from one side by a sensor 8 m away, every stem return moved along its beam by
-// range noise of sigma_m; the viewpoints of the ground's points are unknown (NaN).
+// range noise of sigma_m; the viewpoints of the ground's points are unknown.
 struct OneSidedStem {
-  std::vector<Eigen::Vector3d> points_m, viewpoints_m;
+  std::vector<Eigen::Vector3d> points_m;
+  std::vector<Eigen::Vector3d> sensor_m{{0.0, -8.0, 0.0}};
+  std::vector<std::uint32_t> viewpoint_of;
 };
 OneSidedStem oneSidedStem(double sigma_m, unsigned seed) {
   const double facing = -0.5 * std::numbers::pi, half_arc = 70.0 * std::numbers::pi / 180.0;
@@ -95,8 +98,7 @@ OneSidedStem oneSidedStem(double sigma_m, unsigned seed) {
   const Eigen::Vector2d sensor(0.0, -8.0);
   for (Eigen::Vector3d& p : out.points_m) {
     const bool on_stem = p.head<2>().norm() < 0.5 && p.z() > test::groundZ(p.x(), p.y()) + 0.05;
-    out.viewpoints_m.push_back(on_stem ? Eigen::Vector3d(sensor.x(), sensor.y(), p.z())
-                                       : Eigen::Vector3d::Constant(std::nan("")));
+    out.viewpoint_of.push_back(on_stem ? 0 : Viewpoints::kUnknown);
     if (on_stem) p.head<2>() += range_noise(rng) * (p.head<2>() - sensor).normalized();
   }
   return out;
@@ -105,10 +107,21 @@ OneSidedStem oneSidedStem(double sigma_m, unsigned seed) {
 double dbhOfTheStem(const OneSidedStem& stem, bool with_viewpoints) {
   const Inventory inventory =
       takeInventory(stem.points_m, {},
-                    with_viewpoints ? std::span<const Eigen::Vector3d>(stem.viewpoints_m)
-                                    : std::span<const Eigen::Vector3d>());
+                    with_viewpoints ? Viewpoints{stem.sensor_m, stem.viewpoint_of} : Viewpoints{});
   EXPECT_EQ(inventory.stems.size(), 1u);
   return inventory.stems.empty() ? 0.0 : inventory.stems.front().dbh_m;
+}
+
+TEST(Stems, ViewpointsThatDoNotFitThePointsAreRefused) {
+  OneSidedStem stem = oneSidedStem(0.01, 1);
+  const TerrainModel terrain = buildTerrainModel(stem.points_m);
+  const std::vector<std::uint32_t> too_few(stem.points_m.size() - 1, 0);
+  EXPECT_THROW(detectStems(stem.points_m, terrain, {}, Viewpoints{stem.sensor_m, too_few}),
+               std::invalid_argument);
+  stem.viewpoint_of.front() = 1;  // there is one sensor position
+  EXPECT_THROW(
+      detectStems(stem.points_m, terrain, {}, Viewpoints{stem.sensor_m, stem.viewpoint_of}),
+      std::invalid_argument);
 }
 
 TEST(Stems, RangeNoiseOnAOneSidedStemLeavesItsDbhUnbiasedWhenTheViewpointsAreGiven) {

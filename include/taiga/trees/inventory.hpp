@@ -29,10 +29,9 @@ struct Inventory {
 };
 
 /// Terrain and stems of `points_m` (local coordinates: subtract a large offset first);
-/// `viewpoints_m` as in detectStems.
+/// `viewpoints` as in detectStems.
 Inventory takeInventory(std::span<const Eigen::Vector3d> points_m,
-                        const InventoryOptions& options = {},
-                        std::span<const Eigen::Vector3d> viewpoints_m = {});
+                        const InventoryOptions& options = {}, const Viewpoints& viewpoints = {});
 
 struct PointLabels {
   std::vector<std::uint8_t> classification;  ///< kClassGround, kClassStem or kClassOther

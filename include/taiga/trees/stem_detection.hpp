@@ -82,12 +82,21 @@ struct Stem {
   }
 };
 
+/// Where the points of a lidar map were measured from: the sensor's positions (a map's: one per
+/// keyframe) and per point the index of its own, kUnknown where it is not known. 4 bytes per
+/// point, where a position per point would take 24.
+struct Viewpoints {
+  static constexpr std::uint32_t kUnknown = 0xffffffff;
+  std::span<const Eigen::Vector3d> positions_m;
+  std::span<const std::uint32_t> of_point;  ///< empty (none known), or one per point
+};
+
 /// Stems in `points_m` (local coordinates, m) over `terrain`, sorted by x then y. Deterministic.
-/// `viewpoints_m`: empty, or per point the position of the sensor that measured it (a lidar map:
-/// the keyframe's), so the DBH fit measures range noise along the beams (circle_fit.hpp).
+/// With `viewpoints` the DBH fit measures range noise along the beams (circle_fit.hpp).
+/// std::invalid_argument when `viewpoints` does not fit the points.
 std::vector<Stem> detectStems(std::span<const Eigen::Vector3d> points_m,
                               const TerrainModel& terrain, const StemOptions& options = {},
-                              std::span<const Eigen::Vector3d> viewpoints_m = {});
+                              const Viewpoints& viewpoints = {});
 
 /// Sorts by x, then y (the order of trees.csv).
 void sortByPosition(std::vector<Stem>& stems);
