@@ -5,7 +5,6 @@
 #include <bit>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <limits>
 #include <optional>
 
@@ -104,10 +103,17 @@ void checkSize(const KeyframeFileHeader& header, std::uint64_t size, std::string
 }
 
 std::string readAll(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(fmt::format("{}: cannot open the keyframe file", path.string()));
-  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw InputError(fmt::format("{}: read error", path.string()));
+  // One read of the whole file (a character iterator costs several times as much).
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw InputError(fmt::format("{}: cannot read its size", path.string()));
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), size);
+  if (in.gcount() != size)
+    throw InputError(
+        fmt::format("{}: read error ({} of {} bytes)", path.string(), in.gcount(), size));
   return bytes;
 }
 

@@ -1,7 +1,10 @@
 #include "online_trees.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
-#include <chrono>
+#include <ctime>
 #include <limits>
 
 #include "taiga/core/errors.hpp"
@@ -14,11 +17,23 @@ namespace {
 
 constexpr std::size_t kKeyframesPerUpdate = 20;
 constexpr double kRegionKeyframes_m = 10.0;  ///< keyframes this close to a new one are loaded
-constexpr double kCropMargin_m = 20.0;       ///< points this far beyond the new keyframes are kept
 constexpr double kSeen_m = 15.0;             ///< stems this close to a new keyframe are refitted
+/// Points this close to a new keyframe are kept (within kCropThinning_m more): the stems within
+/// kSeen_m and the ground around them. A stem beyond, only added where the list has none, is
+/// found by a later update or the final inventory.
+constexpr double kCrop_m = kSeen_m + 1.0;
+constexpr double kCropThinning_m = 1.0;
 
 double distanceXy(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return (a.head<2>() - b.head<2>()).norm();
+}
+
+// CPU time of the calling thread: at idle priority the wall time of an update includes the
+// waits for the CPU, which cost the run nothing.
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 bool overlap(const trees::Stem& a, const trees::Stem& b) {
@@ -60,23 +75,33 @@ void OnlineTrees::onKeyframe(std::uint64_t id, const ScanOutcome& scan) {
 }
 
 void OnlineTrees::run() {
+  // The tree map takes only the CPU that the odometry, the mapping and other programs leave
+  // idle: on a machine that keeps up with the sensor that is most of it, and in a replay faster
+  // than real time the updates fall behind and are merged instead of slowing the run.
+  pthread_setname_np(pthread_self(), "taiga-trees");  // as top and perf show it
+  const sched_param idle{.sched_priority = 0};
+  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0)
+    logger().debug("online tree map: the worker runs at normal priority (SCHED_IDLE refused)");
   std::unique_lock lock(mutex_);
   while (true) {
     wake_.wait(lock, [this] { return stopping_ || !jobs_.empty(); });
     if (jobs_.empty()) return;  // stopping, and every job done
-    std::vector<Keyframe> fresh = std::move(jobs_.front());
-    jobs_.pop_front();
+    // Jobs that queued while the worker waited for the CPU become one update of their region.
+    std::vector<Keyframe> fresh;
+    for (const std::vector<Keyframe>& job : jobs_)
+      fresh.insert(fresh.end(), job.begin(), job.end());
+    jobs_.clear();
     lock.unlock();
-    const auto start = std::chrono::steady_clock::now();
+    const double start_s = threadCpuSeconds();
     try {
       update(fresh);
     } catch (const std::exception& e) {  // a keyframe file unreadable: the tree map goes on
       logger().warn("online tree map: update skipped: {}", e.what());
     }
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = threadCpuSeconds() - start_s;
     lock.lock();
     work_s_ += seconds;
+    ++updates_;
   }
 }
 
@@ -92,14 +117,20 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
       best = std::min(best, distanceXy(p, k.T_map_body.translation()));
     return best;
   };
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();
-  for (const Keyframe& k : fresh) center += k.T_map_body.translation();
-  center /= static_cast<double>(fresh.size());
-  double crop_m = 0.0;
-  for (const Keyframe& k : fresh)
-    crop_m = std::max(crop_m, distanceXy(k.T_map_body.translation(), center));
-  crop_m += kCropMargin_m;
-
+  // The crop tests each point against the new keyframes thinned to one per kCropThinning_m
+  // (merged jobs can hold hundreds), so it keeps everything within kCrop_m of them.
+  std::vector<Eigen::Vector3d> crop_centres_m;
+  for (const Keyframe& k : fresh) {
+    const Eigen::Vector3d& p = k.T_map_body.translation();
+    if (std::none_of(crop_centres_m.begin(), crop_centres_m.end(),
+                     [&](const Eigen::Vector3d& c) { return distanceXy(p, c) < kCropThinning_m; }))
+      crop_centres_m.push_back(p);
+  }
+  auto inCrop = [&](const Eigen::Vector3d& p) {
+    return std::any_of(crop_centres_m.begin(), crop_centres_m.end(), [&](const Eigen::Vector3d& c) {
+      return distanceXy(p, c) <= kCrop_m + kCropThinning_m;
+    });
+  };
   std::vector<Eigen::Vector3d> points_m, sensors_m;
   std::vector<std::uint32_t> sensor_of;
   for (const Keyframe& k : all) {
@@ -107,7 +138,7 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
     sensors_m.push_back(k.T_map_body.translation());
     for (const Eigen::Vector3d& p_body : store_.load(k.id).positions) {
       const Eigen::Vector3d p = k.T_map_body * p_body;
-      if (distanceXy(p, center) > crop_m) continue;
+      if (!inCrop(p)) continue;
       points_m.push_back(p);
       sensor_of.push_back(static_cast<std::uint32_t>(sensors_m.size() - 1));
     }
@@ -174,6 +205,11 @@ std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
 double OnlineTrees::workSeconds() const {
   std::lock_guard lock(mutex_);
   return work_s_;
+}
+
+std::size_t OnlineTrees::updates() const {
+  std::lock_guard lock(mutex_);
+  return updates_;
 }
 
 }  // namespace taiga::pipeline

@@ -4,8 +4,9 @@
 // tree list, written to RUN/trees.csv (replaced atomically, so it can be read while the run goes).
 //
 // - Region: the keyframes within 10 m of the new ones, their full scans from the keyframe store
-//   placed with the live poses (T_map_odom * T_odom_body as published), cropped to 20 m around
-//   the new keyframes; trees::takeInventory on it.
+//   placed with the live poses (T_map_odom * T_odom_body as published), cropped to 16 m of the
+//   new keyframes; trees::takeInventory on it.
+// - Priority: the worker runs at idle priority (SCHED_IDLE); jobs that queue meanwhile are merged.
 // - Merge: a stem within 15 m of a new keyframe has been seen from there and replaces the stems
 //   it overlaps (re-fitted with the new views); one farther out (the region's edge) is added only
 //   where the list has no stem yet.
@@ -44,8 +45,11 @@ class OnlineTrees final : public SlamObserver {
   /// After SlamSystem::finish(): the inventory of the whole map on the final keyframe poses (one
   /// per keyframe, in id order), written to trees.csv. Returns how many stems.
   std::size_t finish(const std::vector<lie::SE3>& final_T_map_body);
-  /// Worker time spent on updates, s (the cost reported in summary.json).
+  /// The worker's CPU time on updates, s (the cost reported in summary.json).
   double workSeconds() const;
+  /// Updates of the live list during the run (jobs that queued while the worker waited for the
+  /// CPU are merged into one).
+  std::size_t updates() const;
 
  private:
   struct Keyframe {
@@ -68,6 +72,7 @@ class OnlineTrees final : public SlamObserver {
   std::deque<std::vector<Keyframe>> jobs_;
   bool stopping_ = false;
   double work_s_ = 0.0;
+  std::size_t updates_ = 0;
   std::thread worker_;
 };
 

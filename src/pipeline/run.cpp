@@ -315,6 +315,7 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     summary.trees = online_trees->finish(mapper.graph().poses());
     summary.trees_final_s = secondsSince(trees_start);
     summary.trees_work_s = online_trees->workSeconds();
+    summary.trees_updates = online_trees->updates();
   }
   const Trajectory corrected = trajectories.write(out, mapper.graph());
   writeLoops(out / "loops.csv", mapper.loopAttempts());

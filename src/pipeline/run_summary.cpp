@@ -140,8 +140,10 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"health", healthJson(s.health)},
   };
   if (s.trees)
-    j["trees_online"] = {
-        {"stems", *s.trees}, {"worker_s", s.trees_work_s}, {"final_s", s.trees_final_s}};
+    j["trees_online"] = {{"stems", *s.trees},
+                         {"updates", s.trees_updates},
+                         {"worker_s", s.trees_work_s},
+                         {"final_s", s.trees_final_s}};
   if (s.realtime) {
     j["realtime"] = {{"dropped_scans", s.realtime->dropped_scans},
                      {"latency_ms",

@@ -31,15 +31,27 @@ std::optional<Circle> circleThrough(const Vector2d& a, const Vector2d& b, const 
 
 // RANSAC score: points on the ring, minus those well inside it. A stem is solid, so a large
 // circle through branches and foliage around it (many points, many inside) loses to the stem's
-// own ring.
-long ringScore(std::span<const Vector2d> points_m, const Circle& circle, double band_m) {
+// own ring. On squared distances (no square root; the loop vectorizes): |d - r| < band is
+// (r - band)^2 < d^2 < (r + band)^2 when r > band, d^2 < (r + band)^2 otherwise, and
+// d - r < -2 band is d^2 < (r - 2 band)^2 when r > 2 band, never otherwise.
+// Returns `beat` as soon as the score cannot exceed it (each remaining point adds at most 1): the
+// caller keeps a circle only when it scores more than the best so far.
+long ringScore(std::span<const Vector2d> points_m, const Circle& circle, double band_m, long beat) {
+  const double r = circle.radius_m;
+  const double on_lo2 = r > band_m ? (r - band_m) * (r - band_m) : -1.0;
+  const double on_hi2 = (r + band_m) * (r + band_m);
+  const double inside2 = r > 2.0 * band_m ? (r - 2.0 * band_m) * (r - 2.0 * band_m) : -1.0;
+  const double cx = circle.center_m.x(), cy = circle.center_m.y();
+  constexpr std::size_t kChunk = 32;
   long score = 0;
-  for (const Vector2d& p : points_m) {
-    const double e = (p - circle.center_m).norm() - circle.radius_m;
-    if (std::abs(e) < band_m)
-      ++score;
-    else if (e < -2.0 * band_m)
-      --score;
+  for (std::size_t start = 0; start < points_m.size(); start += kChunk) {
+    const std::size_t end = std::min(points_m.size(), start + kChunk);
+    for (std::size_t i = start; i < end; ++i) {
+      const double dx = points_m[i].x() - cx, dy = points_m[i].y() - cy;
+      const double d2 = dx * dx + dy * dy;
+      score += static_cast<long>(d2 > on_lo2 && d2 < on_hi2) - static_cast<long>(d2 < inside2);
+    }
+    if (score + static_cast<long>(points_m.size() - end) <= beat) return beat;
   }
   return score;
 }
@@ -307,7 +319,7 @@ std::optional<CircleFit> fitCircleRobust(std::span<const Vector2d> points_m,
     if (!circle || circle->radius_m < options.min_radius_m ||
         circle->radius_m > options.max_radius_m)
       continue;
-    const long score = ringScore(sample, *circle, options.inlier_band_m);
+    const long score = ringScore(sample, *circle, options.inlier_band_m, best_score);
     if (score > best_score) {
       best_score = score;
       best = circle;

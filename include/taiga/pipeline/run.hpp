@@ -173,9 +173,10 @@ struct RunSummary {
                   foxglove_history_dropped = 0;
   };
   std::optional<Streams> streams;
-  /// With mapping.trees: the stems in trees.csv, the worker's busy time on the live list during
-  /// the run and the final inventory's time after it, s.
+  /// With mapping.trees: the stems in trees.csv, the live list's updates and its worker's busy
+  /// time during the run, and the final inventory's time after it, s.
   std::optional<std::size_t> trees;
+  std::size_t trees_updates = 0;
   double trees_work_s = 0.0;
   double trees_final_s = 0.0;
 };
