@@ -49,13 +49,18 @@ class NearestWithin {
 
 }  // namespace
 
+// Leaves of up to 32 points (nanoflann's default is 10): on the local map (about 300 000 points,
+// rebuilt at every keyframe) the build and the fitness's 4000 queries per scan together took 20 %
+// less CPU (perf samples, handheld walk); a search is exact at any leaf size.
+constexpr std::size_t kLeafMaxSize = 32;
+
 struct KdTree::Impl {
   std::vector<Eigen::Vector3d> points;
   Adaptor adaptor{&points};
   Tree tree;
   explicit Impl(std::span<const Eigen::Vector3d> p)
       : points(p.begin(), p.end()),
-        tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {}
+        tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafMaxSize)) {}
 };
 
 KdTree::KdTree(std::span<const Eigen::Vector3d> points) : impl_(std::make_unique<Impl>(points)) {}
