@@ -149,8 +149,8 @@ int run(const RunOptions& options) {
              s.loop_closures, s.map_export_s);
   if (s.trees)
     fmt::print(
-        "trees      {} stems in trees.csv (the live list: {} updates, {:.1f} s of idle CPU "
-        "during the run; the final inventory {:.1f} s after it)\n",
+        "trees      {} stems in trees.csv (the live list: {} updates, {:.1f} CPU-s at idle "
+        "priority during the run; the final inventory {:.1f} s after it)\n",
         *s.trees, s.trees_updates, s.trees_work_s, s.trees_final_s);
   if (s.streams)
     fmt::print(

@@ -4,8 +4,8 @@
 // tree list, written to RUN/trees.csv (replaced atomically, so it can be read while the run goes).
 //
 // - Region: the keyframes within 10 m of the new ones, their full scans from the keyframe store
-//   placed with the live poses (T_map_odom * T_odom_body as published), cropped to 16 m of the
-//   new keyframes; trees::takeInventory on it.
+//   placed with the live poses (T_map_odom * T_odom_body as published), cropped to 16-17 m of
+//   the new keyframes; trees::takeInventory on it.
 // - Priority: the worker runs at idle priority (SCHED_IDLE); jobs that queue meanwhile are merged.
 // - Merge: a stem within 15 m of a new keyframe has been seen from there and replaces the stems
 //   it overlaps (re-fitted with the new views); one farther out (the region's edge) is added only

@@ -31,7 +31,7 @@ std::optional<Circle> circleThrough(const Vector2d& a, const Vector2d& b, const 
 
 // RANSAC score: points on the ring, minus those well inside it. A stem is solid, so a large
 // circle through branches and foliage around it (many points, many inside) loses to the stem's
-// own ring. On squared distances (no square root; the loop vectorizes): |d - r| < band is
+// own ring. On squared distances (no square root): |d - r| < band is
 // (r - band)^2 < d^2 < (r + band)^2 when r > band, d^2 < (r + band)^2 otherwise, and
 // d - r < -2 band is d^2 < (r - 2 band)^2 when r > 2 band, never otherwise.
 // Returns `beat` as soon as the score cannot exceed it (each remaining point adds at most 1): the
