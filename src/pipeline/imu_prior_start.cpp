@@ -91,6 +91,16 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
   estimate.bias = init.bias;
   estimate.covariance = init.covariance;
   estimate.covariance.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() * 0.2 * 0.2;
+  if (!levelled_) {
+    // Until the levelling, the odom frame's gravity is off by the start's tilt error (degrees
+    // while moving: 1 m/s^2 at 6 deg). A loose accelerometer bias absorbs it at once, so the
+    // smoother's attitude follows the lidar instead of bending the map towards the wrong
+    // gravity; the alignment then estimates the bias afresh (levelFrame).
+    constexpr double kUnlevelledAccelBiasSigma_mps2 = 1.0;
+    estimate.covariance.block<3, 3>(9, 9) = Eigen::Matrix3d::Identity() *
+                                            kUnlevelledAccelBiasSigma_mps2 *
+                                            kUnlevelledAccelBiasSigma_mps2;
+  }
   smoother_.initialize(estimate);
 
   FirstScan out{.index = first.index,
@@ -112,8 +122,14 @@ std::optional<lie::SE3> ImuPrior::collectForAlignment(double t_s, const lie::SE3
 }
 
 std::optional<lie::SE3> ImuPrior::levelFrame() {
+  // The bias the unlevelled smoother held is mostly the frame's tilt error, so the alignment
+  // takes the increments at a zero bias and estimates gravity and the bias together. Over 2 s a
+  // horizontal bias and a tilt look alike and this prior decides between them (a wider one
+  // helped the `harsh` rig and hurt `typical` ones: docs/odometry.md, Height).
+  constexpr double kAlignmentAccelBiasSigma_mps2 = 0.3;
   const imu::GravityAlignment a =
-      imu::alignGravity(alignment_poses_, alignment_increments_, config_.imu.gravity_mps2);
+      imu::alignGravity(alignment_poses_, alignment_increments_, config_.imu.gravity_mps2,
+                        kAlignmentAccelBiasSigma_mps2);
   alignment_times_.clear();
   alignment_poses_.clear();
   alignment_increments_.clear();
@@ -143,13 +159,19 @@ std::optional<lie::SE3> ImuPrior::levelFrame() {
   levelled.covariance.diagonal().head<9>() << Eigen::Vector3d::Constant(1e-6),
       tilt_sigma * tilt_sigma, tilt_sigma * tilt_sigma, 1e-6,
       Eigen::Vector3d::Constant(0.05 * 0.05);
+  // The accelerometer bias from the alignment, with the start's prior sigma.
+  levelled.bias.accel_mps2 = a.accel_bias_mps2;
+  levelled.covariance.block<3, 15>(9, 0).setZero();
+  levelled.covariance.block<15, 3>(0, 9).setZero();
+  levelled.covariance.block<3, 3>(9, 9) = Eigen::Matrix3d::Identity() * 0.05 * 0.05;
   smoother_.initialize(levelled);
   const double tilt_deg =
       std::acos(std::clamp(a.gravity_world.normalized().z() * -1.0, -1.0, 1.0)) / kRadPerDeg;
   logger().info(
       "gravity alignment: the initial attitude was off by {:.2f} deg of tilt; odom frame levelled "
-      "(|g| estimated {:.3f} m/s^2)",
-      tilt_deg, a.estimated_magnitude_mps2);
+      "(|g| estimated {:.3f} m/s^2, accelerometer bias {:.3f} {:.3f} {:.3f} m/s^2)",
+      tilt_deg, a.estimated_magnitude_mps2, a.accel_bias_mps2.x(), a.accel_bias_mps2.y(),
+      a.accel_bias_mps2.z());
   initialization_note_ +=
       fmt::format("; levelled after {:.1f} s by {:.2f} deg", config_.gravity_alignment_s, tilt_deg);
   return lie::SE3(a.R_levelled_world, Eigen::Vector3d::Zero());
