@@ -95,8 +95,8 @@ GravityAlignment alignGravity(std::span<const lie::SE3> poses,
   const Eigen::Index n_poses = static_cast<Eigen::Index>(poses.size());
   const Eigen::Index data_rows = 6 * (n_poses - 1);
   const bool with_bias = accel_bias_sigma_mps2 > 0.0;
-  // The rows' own error (m, m/s): millimetres of registration error per scan. The bias prior's
-  // row weighs 1/sigma in those units.
+  // The rows are unweighted, in m and m/s; taken as 1 cm and 1 cm/s, the bias prior's row
+  // weighs that over its sigma (measured registrations are better: the prior counts for more).
   constexpr double kRowSigma = 0.01;
   const double bias_prior_weight = with_bias ? kRowSigma / accel_bias_sigma_mps2 : 0.0;
 
