@@ -130,9 +130,6 @@ std::optional<lie::SE3> ImuPrior::levelFrame() {
   const imu::GravityAlignment a =
       imu::alignGravity(alignment_poses_, alignment_increments_, config_.imu.gravity_mps2,
                         kAlignmentAccelBiasSigma_mps2);
-  // The levelled attitude is the lidar's, whose poses the alignment levelled: at the end of the
-  // window the smoother's may lean up to a degree towards the IMU's (unlevelled) gravity.
-  const lie::SO3 R_unlevelled_body = alignment_poses_.back().rotation();
   alignment_times_.clear();
   alignment_poses_.clear();
   alignment_increments_.clear();
@@ -149,7 +146,7 @@ std::optional<lie::SE3> ImuPrior::levelFrame() {
   }
   const backend::StateEstimate current = smoother_.latest();
   backend::StateEstimate levelled = current;
-  levelled.state.R_world_body = a.R_levelled_world * R_unlevelled_body;
+  levelled.state.R_world_body = a.R_levelled_world * current.state.R_world_body;
   levelled.state.p_world = a.R_levelled_world * current.state.p_world;
   levelled.state.v_world = a.R_levelled_world * a.v_world.back();
   // Tilt and velocity now come from the alignment; position and heading keep fixing the gauge.
