@@ -26,8 +26,7 @@ struct Unknowns {
 /// Two unit vectors spanning the plane orthogonal to g.
 Eigen::Matrix<double, 3, 2> tangentBasis(const Vector3& g) {
   const Vector3 n = g.normalized();
-  const Vector3 t1 =
-      n.cross(std::abs(n.z()) < 0.9 ? Vector3::UnitZ() : Vector3::UnitX()).normalized();
+  const Vector3 t1 = n.unitOrthogonal();
   Eigen::Matrix<double, 3, 2> basis;
   basis << t1, n.cross(t1);
   return basis;
@@ -122,7 +121,6 @@ GravityAlignment alignGravity(std::span<const lie::SE3> poses,
       x = step.A.colPivHouseholderQr().solve(step.b);
       const Vector3 g_step = tangentBasis(result.gravity_world) * x.segment<2>(3 * n_poses);
       result.gravity_world = (result.gravity_world + g_step).normalized() * gravity_mps2;
-      result.accel_bias_mps2 = x.tail<3>();
     }
   }
   // The velocities (and the bias) for the final gravity.
