@@ -2,13 +2,16 @@
 // "profile first"): crop (range and boxes), deskew, the registration's voxel filter and the
 // keyframe's. Each stage is timed per scan, the median over the scans is printed, and the
 // median over RUNS passes of the whole set. The deskew uses the ground truth trajectory (it
-// costs the same with any trajectory).
+// costs the same with any trajectory). The last line is a checksum of every stage's output (the
+// deskewed points and both voxel filters' points, bit for bit): an optimization that should not
+// change them must not change it.
 //
 //   preprocess_bench SIM [RUNS=3] [SCANS=100]     SIM: a `taiga simulate` output directory
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -29,6 +32,14 @@ namespace {
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+/// FNV-1a over the bytes of the points, continued from `hash`.
+std::uint64_t checksum(const std::vector<Eigen::Vector3d>& points, std::uint64_t hash) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(points.data());
+  for (std::size_t i = 0; i < points.size() * sizeof(Eigen::Vector3d); ++i)
+    hash = (hash ^ bytes[i]) * 0x100000001b3ULL;
+  return hash;
 }
 
 double msSince(Clock::time_point start) {
@@ -63,6 +74,7 @@ int main(int argc, char** argv) {
   const char* names[] = {"crop", "deskew", "voxel (scan)", "voxel (keyframe)", "sum"};
   std::vector<std::vector<double>> per_run(5);
   std::size_t points = 0, kept = 0, voxels = 0;
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
   for (int run = 0; run < runs; ++run) {
     std::vector<std::vector<double>> ms(5);
     for (const io::Scan& scan : scans) {
@@ -86,6 +98,9 @@ int main(int argc, char** argv) {
       points += scan.cloud_in_lidar.size();
       kept += n;
       voxels += source.size();
+      if (run == 0)
+        hash = checksum(keyframe.positions,
+                        checksum(source.positions, checksum(in_body.positions, hash)));
     }
     for (int s = 0; s < 5; ++s) per_run[s].push_back(median(ms[s]));
   }
@@ -96,5 +111,6 @@ int main(int argc, char** argv) {
       "median ms per scan (median over runs); sum: what every scan pays (not the "
       "keyframe's voxel filter)\n");
   for (int s = 0; s < 5; ++s) fmt::print("  {:18s} {:7.3f}\n", names[s], median(per_run[s]));
+  fmt::print("checksum of the outputs {:016x}\n", hash);
   return 0;
 }
