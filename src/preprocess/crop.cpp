@@ -7,11 +7,15 @@ namespace taiga::preprocess {
 
 namespace {
 
-// One select for any test: each select copies every channel of the kept points.
+// One select for any test: each select copies every channel of the kept points. When every
+// point is kept (most scans without boxes), the channels are copied whole, which is cheaper.
 template <class Keep>
 PointCloud keepIf(const PointCloud& cloud, Keep keep) {
+  std::size_t n_kept = 0;
+  for (const Eigen::Vector3d& p : cloud.positions) n_kept += keep(p) ? 1 : 0;
+  if (n_kept == cloud.size()) return cloud;
   std::vector<std::size_t> kept;
-  kept.reserve(cloud.size());
+  kept.reserve(n_kept);
   for (std::size_t i = 0; i < cloud.size(); ++i)
     if (keep(cloud.positions[i])) kept.push_back(i);
   return cloud.select(kept);
