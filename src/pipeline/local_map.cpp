@@ -1,5 +1,8 @@
 #include "taiga/pipeline/local_map.hpp"
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 #include <stdexcept>
 
 namespace taiga::pipeline {
@@ -30,17 +33,23 @@ LocalMap::~LocalMap() {
   if (pending_.valid()) pending_.wait();
 }
 
+// The NDT targets and the kd-tree (with the GICP cloud) are independent: built side by side. Each
+// is built by one thread as before, so the result is the same on any number of threads.
 LocalMap::SearchStructures LocalMap::build() const {
   SearchStructures built;
-  const std::vector<Eigen::Vector3d> points = point_statistics_.means();
-  if (target_ == Target::kNdt) {
+  std::vector<Eigen::Vector3d> points;
+  auto build_ndt = [&] {
     for (const registration::VoxelStatistics& statistics : ndt_statistics_)
       built.ndt_targets.push_back(
           std::make_unique<registration::NdtTarget>(statistics, ndt_cells_));
-  } else {
-    built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
-  }
-  built.kd_tree = std::make_unique<registration::KdTree>(points);
+  };
+  auto build_points = [&] {
+    points = point_statistics_.means();
+    built.kd_tree = std::make_unique<registration::KdTree>(points);
+    if (target_ == Target::kGicp)
+      built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
+  };
+  tbb::parallel_invoke(build_ndt, build_points);
   return built;
 }
 
@@ -48,18 +57,24 @@ void LocalMap::finishPendingBuild() {
   if (pending_.valid()) in_use_ = pending_.get();
 }
 
-void LocalMap::account(const Keyframe& keyframe, Change change) {
-  std::vector<Eigen::Vector3d> points_in_world = keyframe.points_in_keyframe;
-  for (Eigen::Vector3d& p : points_in_world) p = keyframe.T_odom_keyframe * p;
-  // Removal subtracts exactly what adding added: the same points through the same pose.
-  auto apply = [&](registration::VoxelStatistics& statistics) {
-    if (change == Change::kAdd)
-      statistics.add(points_in_world);
-    else
-      statistics.remove(points_in_world);
+void LocalMap::account(const std::vector<const Keyframe*>& added,
+                       const std::vector<const Keyframe*>& removed) {
+  auto inOdom = [](const Keyframe& keyframe) {
+    std::vector<Eigen::Vector3d> points_in_odom = keyframe.points_in_keyframe;
+    for (Eigen::Vector3d& p : points_in_odom) p = keyframe.T_odom_keyframe * p;
+    return points_in_odom;
   };
-  for (registration::VoxelStatistics& statistics : ndt_statistics_) apply(statistics);
-  apply(point_statistics_);
+  std::vector<std::vector<Eigen::Vector3d>> added_in_odom, removed_in_odom;
+  for (const Keyframe* keyframe : added) added_in_odom.push_back(inOdom(*keyframe));
+  for (const Keyframe* keyframe : removed) removed_in_odom.push_back(inOdom(*keyframe));
+  // Removal subtracts exactly what adding added: the same points through the same pose. The
+  // statistics are independent and each is updated by one thread, in the same order as before.
+  std::vector<registration::VoxelStatistics*> all{&point_statistics_};
+  for (registration::VoxelStatistics& statistics : ndt_statistics_) all.push_back(&statistics);
+  tbb::parallel_for(std::size_t{0}, all.size(), [&](std::size_t i) {
+    for (const auto& points : added_in_odom) all[i]->add(points);
+    for (const auto& points : removed_in_odom) all[i]->remove(points);
+  });
 }
 
 void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
@@ -76,9 +91,9 @@ void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
   // "Session 37"). Nothing else reads them until finishPendingBuild().
   pending_ = std::async(std::launch::async,
                         [this, &added = keyframes_.back(), dropped = std::move(dropped)] {
-                          account(added, Change::kAdd);
-                          for (const Keyframe& keyframe : dropped)
-                            account(keyframe, Change::kRemove);
+                          std::vector<const Keyframe*> removed;
+                          for (const Keyframe& keyframe : dropped) removed.push_back(&keyframe);
+                          account({&added}, removed);
                           return build();
                         });
   registrations_since_keyframe_ = 0;
@@ -90,10 +105,12 @@ void LocalMap::repose(
   finishPendingBuild();
   for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
   point_statistics_.clear();
+  std::vector<const Keyframe*> all;
   for (Keyframe& keyframe : keyframes_) {
     keyframe.T_odom_keyframe = T_odom_keyframe_at(keyframe.id, keyframe.T_odom_keyframe);
-    account(keyframe, Change::kAdd);
+    all.push_back(&keyframe);
   }
+  account(all, {});
   in_use_ = {};  // so that beginRegistration() waits for the structures in the new frame
   if (!keyframes_.empty()) pending_ = std::async(std::launch::async, [this] { return build(); });
 }

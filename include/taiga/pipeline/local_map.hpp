@@ -100,9 +100,9 @@ class LocalMap {
     lie::SE3 T_odom_keyframe;
     std::vector<Eigen::Vector3d> points_in_keyframe;
   };
-  enum class Change { kAdd, kRemove };
-  /// Adds a keyframe's points, in the odom frame, to the statistics, or removes them.
-  void account(const Keyframe& keyframe, Change change);
+  /// Adds keyframes' points, in the odom frame, to the statistics, then removes others'.
+  void account(const std::vector<const Keyframe*>& added,
+               const std::vector<const Keyframe*>& removed);
 
   std::deque<Keyframe> keyframes_;
   std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
