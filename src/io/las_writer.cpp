@@ -19,11 +19,11 @@ static_assert(std::endian::native == std::endian::little,
 constexpr std::uint16_t kHeaderSize = 375;  // LAS 1.4 public header block
 constexpr std::uint16_t kVlrHeaderSize = 54;
 constexpr std::uint8_t kPointFormat = 6;
-constexpr std::uint16_t kPointRecordSize = 30;  // format 6
+constexpr std::uint16_t kPointRecordSize = 30;    // format 6
 constexpr std::uint16_t kExtraBytesRecordId = 4;  // LASF_Spec: Extra Bytes
 constexpr std::uint16_t kExtraBytesEntrySize = 192;
-constexpr std::uint8_t kExtraFloatType = 9;     // float32
-constexpr std::uint16_t kWktRecordId = 2112;    // LASF_Projection: OGC coordinate system WKT
+constexpr std::uint8_t kExtraFloatType = 9;   // float32
+constexpr std::uint16_t kWktRecordId = 2112;  // LASF_Projection: OGC coordinate system WKT
 constexpr std::uint16_t kGlobalEncodingWkt = 1 << 4;
 
 class Bytes {
@@ -39,6 +39,7 @@ class Bytes {
     data_ += field;
   }
   void putZeros(std::size_t n) { data_.append(n, '\0'); }
+  void reserve(std::size_t n) { data_.reserve(n); }
   const std::string& data() const { return data_; }
 
  private:
@@ -182,6 +183,8 @@ void LasWriter::appendRecords(const PointCloud& cloud, const LasPointFields& fie
       throw InputError(fmt::format("{}: the points have non-finite coordinates", path_.string()));
   }
   Bytes records;
+  records.reserve(cloud.size() *
+                  (kPointRecordSize + (options_.extra_float_name.empty() ? 0 : sizeof(float))));
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d& p = cloud.positions[i];
     Eigen::Vector3d stored;
@@ -200,7 +203,7 @@ void LasWriter::appendRecords(const PointCloud& cloud, const LasPointFields& fie
     records.put<std::uint8_t>(static_cast<std::uint8_t>(
         number | (fields.returns.empty() ? 1 : fields.returns[i][1]) << 4));
     ++points_by_return_[number - 1];
-    records.put<std::uint8_t>(0);     // classification flags, scanner channel, scan direction, edge
+    records.put<std::uint8_t>(0);  // classification flags, scanner channel, scan direction, edge
     records.put<std::uint8_t>(fields.classifications.empty() ? options_.classification
                                                              : fields.classifications[i]);
     records.put<std::uint8_t>(
