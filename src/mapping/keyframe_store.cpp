@@ -2,9 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <chrono>
-#include <future>
 #include <list>
 #include <unordered_map>
 
@@ -18,15 +15,11 @@ namespace {
 
 constexpr const char* kPosesFile = "poses.tum";
 
-std::filesystem::path keyframeFile(const std::filesystem::path& dir, std::uint64_t id) {
-  return dir / fmt::format("{:06d}.tkf", id);
-}
-
 std::shared_ptr<const PointCloud> registrationCopy(const PointCloud& cloud_in_body,
                                                    const KeyframeStoreOptions& options) {
   if (options.registration_voxel_m <= 0.0) return std::make_shared<const PointCloud>();
-  const PointCloud filtered = preprocess::voxelFilter(cloud_in_body, options.registration_voxel_m,
-                                                      options.registration_voxel_point);
+  const PointCloud filtered = preprocess::voxelFilter(
+      cloud_in_body, options.registration_voxel_m, options.registration_voxel_point);
   // Registration needs positions only. A fresh vector of the exact size: the filter's own keeps
   // the capacity it grew to (up to twice its size), and up to registration_cache_keyframes
   // copies stay in RAM.
@@ -88,35 +81,13 @@ struct KeyframeStore::Impl {
 
   std::filesystem::path dir;
   KeyframeStoreOptions options;
-  mutable std::mutex mutex;  // guards infos; when both are held, before writes_mutex
+  mutable std::mutex mutex;  // guards infos
   std::vector<KeyframeInfo> infos;
   // Its own lock, never held together with `mutex`: a cache miss reads a file without either.
   mutable std::mutex cache_mutex;  // guards registration_cache and the counters
   mutable RegistrationCache registration_cache;
   mutable std::uint64_t registration_cache_hits = 0;
   mutable std::uint64_t registration_copies_rebuilt = 0;
-  // The files and registration copies of added keyframes are made in the background, one
-  // keyframe after the other in id order (on the odometry's thread they took 6-7 ms per keyframe,
-  // perf). writes[id] is ready once keyframe id's file is complete and its copy cached, and holds
-  // the error if its file could not be written. writes[0, checked) are known to have succeeded.
-  mutable std::mutex writes_mutex;  // guards writes and checked
-  std::vector<std::shared_future<void>> writes;
-  mutable std::size_t checked = 0;
-
-  /// Waits for every write added so far; rethrows the first error. Every reader calls it first,
-  /// so that it sees the store (files and cache) as if add() had written at once.
-  void waitWritten() const {
-    std::vector<std::shared_future<void>> pending;
-    std::size_t first = 0;
-    {
-      const std::lock_guard lock(writes_mutex);
-      first = checked;
-      pending.assign(writes.begin() + static_cast<std::ptrdiff_t>(first), writes.end());
-    }
-    for (const std::shared_future<void>& write : pending) write.get();
-    const std::lock_guard lock(writes_mutex);
-    checked = std::max(checked, first + pending.size());
-  }
 
   const KeyframeInfo& at(std::uint64_t id) const {
     if (id >= infos.size())
@@ -129,13 +100,7 @@ struct KeyframeStore::Impl {
 KeyframeStore::KeyframeStore(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 KeyframeStore::KeyframeStore(KeyframeStore&&) noexcept = default;
 KeyframeStore& KeyframeStore::operator=(KeyframeStore&&) noexcept = default;
-KeyframeStore::~KeyframeStore() {
-  if (!impl_) return;  // moved from
-  const std::lock_guard lock(impl_->writes_mutex);
-  for (const std::shared_future<void>& write : impl_->writes) write.wait();  // errors: flush()
-}
-
-void KeyframeStore::flush() const { impl_->waitWritten(); }
+KeyframeStore::~KeyframeStore() = default;
 
 KeyframeStore KeyframeStore::create(const std::filesystem::path& dir,
                                     KeyframeStoreOptions options) {
@@ -183,44 +148,28 @@ KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStor
 
 std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_odom_body,
                                  const PointCloud& cloud_in_body) {
-  std::shared_future<void> previous;
+  std::uint64_t id = 0;
   {
-    const std::lock_guard lock(impl_->writes_mutex);
-    if (!impl_->writes.empty()) previous = impl_->writes.back();
+    const std::lock_guard lock(impl_->mutex);
+    id = impl_->infos.size();
+    if (!impl_->infos.empty() && !(t_s > impl_->infos.back().t_s))
+      throw std::invalid_argument(
+          fmt::format("KeyframeStore::add: time {} is not after {}", t_s, impl_->infos.back().t_s));
   }
-  // An earlier keyframe's write that failed is reported here, as soon as it is known.
-  if (previous.valid() && previous.wait_for(std::chrono::seconds(0)) == std::future_status::ready)
-    previous.get();
-  // A reader that sees the keyframe (size(), info()) must also see its write to wait for: both
-  // are published under the lock.
+  // The slow parts (file, voxel filter) outside the lock: readers of other keyframes go on.
+  writeKeyframeFile(keyframePath(id), id, t_s, cloud_in_body);
+  KeyframeInfo info{
+      .id = id, .t_s = t_s, .T_map_body = T_odom_body, .point_count = cloud_in_body.size()};
+  if (impl_->options.registration_voxel_m > 0.0) {
+    // The newest keyframe is the one loop closure asks for next: cache its copy now, from the
+    // scan at hand, rather than read the file back.
+    std::shared_ptr<const PointCloud> registration =
+        registrationCopy(cloud_in_body, impl_->options);
+    const std::lock_guard cache_lock(impl_->cache_mutex);
+    impl_->registration_cache.insert(id, std::move(registration));
+  }
   const std::lock_guard lock(impl_->mutex);
-  const std::uint64_t id = impl_->infos.size();
-  if (!impl_->infos.empty() && !(t_s > impl_->infos.back().t_s))
-    throw std::invalid_argument(
-        fmt::format("KeyframeStore::add: time {} is not after {}", t_s, impl_->infos.back().t_s));
-  auto cloud = std::make_shared<const PointCloud>(cloud_in_body);
-  Impl* impl = impl_.get();  // outlives the write: the destructor waits for it
-  std::shared_future<void> write =
-      std::async(std::launch::async, [impl, id, t_s, cloud, previous]() mutable {
-        if (previous.valid()) previous.wait();  // one file after the other, in id order
-        writeKeyframeFile(keyframeFile(impl->dir, id), id, t_s, *cloud);
-        if (impl->options.registration_voxel_m > 0.0) {
-          // The newest keyframe is the one loop closure asks for next: cache its copy now, from
-          // the scan at hand, rather than read the file back.
-          std::shared_ptr<const PointCloud> registration = registrationCopy(*cloud, impl->options);
-          const std::lock_guard cache_lock(impl->cache_mutex);
-          impl->registration_cache.insert(id, std::move(registration));
-        }
-        // The future keeps this function object as long as the store: let go of the scan.
-        cloud.reset();
-        previous = {};
-      }).share();
-  {
-    const std::lock_guard writes_lock(impl_->writes_mutex);
-    impl_->writes.push_back(std::move(write));
-  }
-  impl_->infos.push_back(
-      {.id = id, .t_s = t_s, .T_map_body = T_odom_body, .point_count = cloud_in_body.size()});
+  impl_->infos.push_back(info);
   return id;
 }
 
@@ -232,12 +181,11 @@ std::size_t KeyframeStore::size() const {
 const std::filesystem::path& KeyframeStore::directory() const { return impl_->dir; }
 
 std::filesystem::path KeyframeStore::keyframePath(std::uint64_t id) const {
-  return keyframeFile(impl_->dir, id);
+  return impl_->dir / fmt::format("{:06d}.tkf", id);
 }
 
 PointCloud KeyframeStore::load(std::uint64_t id) const {
   const KeyframeInfo info = this->info(id);
-  impl_->waitWritten();
   KeyframeFileContent content = readKeyframeFile(keyframePath(id));
   if (content.header.id != id || content.header.point_count != info.point_count) {
     throw InputError(
@@ -251,7 +199,6 @@ PointCloud KeyframeStore::load(std::uint64_t id) const {
 std::shared_ptr<const PointCloud> KeyframeStore::registrationCloud(std::uint64_t id) const {
   info(id);  // OutOfRangeError for an unknown id
   if (impl_->options.registration_voxel_m <= 0.0) return std::make_shared<const PointCloud>();
-  impl_->waitWritten();  // then its copy is cached
   {
     const std::lock_guard cache_lock(impl_->cache_mutex);
     if (std::shared_ptr<const PointCloud> cached = impl_->registration_cache.find(id)) {
@@ -269,7 +216,6 @@ std::shared_ptr<const PointCloud> KeyframeStore::registrationCloud(std::uint64_t
 }
 
 RegistrationCacheStatistics KeyframeStore::registrationCacheStatistics() const {
-  impl_->waitWritten();
   const std::lock_guard cache_lock(impl_->cache_mutex);
   return {.cached_keyframes = impl_->registration_cache.size(),
           .hits = impl_->registration_cache_hits,
@@ -313,8 +259,6 @@ void KeyframeStore::writePoses(const Trajectory& poses_T_map_body) const {
   if (poses_T_map_body.size() > size())
     throw std::invalid_argument(fmt::format("KeyframeStore::writePoses: {} poses for {} keyframes",
                                             poses_T_map_body.size(), size()));
-  // open() reads a keyframe file for every pose listed: they must be complete.
-  impl_->waitWritten();
   const std::filesystem::path path = impl_->dir / kPosesFile;
   const std::filesystem::path temporary = impl_->dir / (std::string(kPosesFile) + ".tmp");
   io::writeTum(temporary, poses_T_map_body);

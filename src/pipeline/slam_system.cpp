@@ -138,7 +138,6 @@ const mapping::Mapper& SlamSystem::finish() {
     finished_ = true;
   }
   const mapping::Mapper& mapper = mapping_thread_.finish();
-  store_.flush();  // every keyframe file written, or the first write's error
   store_.setPoses(mapper.graph().poses());
   store_.writePoses();
   return mapper;

@@ -2,17 +2,16 @@
 // Keyframes on disk, so that memory stays flat however long the recording (issue 7, item 4).
 //
 // add() writes the keyframe's full-resolution deskewed scan (body frame) to
-// DIR/NNNNNN.tkf (keyframe_file.hpp), in the background (every reader below first waits for the
-// writes of the keyframes added before it, so it sees what a synchronous add() would give), and
-// keeps in RAM only what the mapping needs often: time, pose and point count. When
-// registration_voxel_m > 0, registrationCloud() gives a voxel-filtered, positions-only copy of the
-// scan for loop closure; only the registration_cache_keyframes most recently used copies stay in
-// RAM (least recently used evicted), and a copy not cached is rebuilt from the keyframe file with
-// the same deterministic filter, so it is bit for bit the copy add() made. load() reads the full
-// scan back. The poses are kept in RAM; setPoses() replaces them when the mapping graph corrects
-// them, and writePoses() saves them as DIR/poses.tum (TUM, T_map_body, one line per keyframe in id
-// order), so that `taiga export-map DIR` re-exports a finished run with its final poses, or a
-// running one with its current poses.
+// DIR/NNNNNN.tkf (keyframe_file.hpp) at once and keeps in RAM only what the mapping needs
+// often: time, pose and point count. When registration_voxel_m > 0, registrationCloud() gives a
+// voxel-filtered, positions-only copy of the scan for loop closure; only the
+// registration_cache_keyframes most recently used copies stay in RAM (least recently used
+// evicted), and a copy not cached is rebuilt from the keyframe file with the same deterministic
+// filter, so it is bit for bit the copy add() made. load() reads the full scan back. The poses
+// are kept in RAM; setPoses() replaces them when the mapping
+// graph corrects them, and writePoses() saves them as DIR/poses.tum (TUM, T_map_body, one line
+// per keyframe in id order), so that `taiga export-map DIR` re-exports a finished run with its
+// final poses, or a running one with its current poses.
 //
 // Ids are 0, 1, 2, ... in the order of add(). Thread-safe: one thread may add() while others
 // call load(), registrationCloud(), pose() or setPoses(). A registration copy handed out stays
@@ -77,12 +76,9 @@ class KeyframeStore {
   ~KeyframeStore();
 
   /// Stores a keyframe (its time, odometry pose and full scan in the body frame) and returns its
-  /// id. t_s must be later than the previous keyframe's. The file is written in the background:
-  /// when it cannot be, the InputError comes from a later add(), from flush(), or from a reader
-  /// of that keyframe (load(), registrationCloud(), writePoses()).
+  /// id.
+  /// t_s must be later than the previous keyframe's. InputError when the file cannot be written.
   std::uint64_t add(double t_s, const lie::SE3& T_odom_body, const PointCloud& cloud_in_body);
-  /// Waits until every added keyframe is on disk; the first write's InputError, if any.
-  void flush() const;
 
   std::size_t size() const;
   bool empty() const { return size() == 0; }
