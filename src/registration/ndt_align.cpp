@@ -144,9 +144,10 @@ RegistrationResult alignNdt(std::span<const Eigen::Vector3d> source, const NdtTa
     return failed(guess, "target has no NDT cell with at least " +
                              std::to_string(config.min_points_per_cell) + " points");
   }
+  NeighbourCache cache(source.size());
   return newton(
       [&](const lie::SE3& T, bool with_hessian) {
-        return ndtDerivatives(source, target, T, config, with_hessian);
+        return ndtDerivatives(source, target, T, config, with_hessian, &cache);
       },
       guess, config, config.max_step_cells * target.resolution_m());
 }

@@ -106,14 +106,27 @@ Eigen::Matrix3d regularize(const Eigen::Matrix3d& covariance, double min_eigenva
 
 NdtDerivatives ndtDerivatives(std::span<const Eigen::Vector3d> source, const NdtTarget& target,
                               const lie::SE3& T_target_source, const NdtConfig& config,
-                              bool with_hessian) {
+                              bool with_hessian, NeighbourCache* cache) {
   const NdtConstants k = ndtConstants(target.resolution_m(), config.outlier_ratio);
   const Eigen::Matrix3d R = T_target_source.rotation().matrix();
   const Eigen::Vector3d t = T_target_source.translation();
   return reduce(source.size(), T_target_source, [&](std::size_t i, Partial& out) {
     const Eigen::Vector3d p = R * source[i] + t;
-    const NdtCell* cells[7];
-    const int n = target.neighbours(p, config.search, cells);
+    const NdtCell* found[7];
+    const NdtCell* const* cells = found;
+    int n = 0;
+    if (cache) {  // each point's entry is written by the one thread that scores the point
+      NeighbourCache::Entry& entry = cache->entries[i];
+      const VoxelKey key = target.voxelOf(p);
+      if (key != entry.key) {
+        entry.key = key;
+        entry.count = target.neighboursOf(key, config.search, entry.cells);
+      }
+      n = entry.count;
+      cells = entry.cells;
+    } else {
+      n = target.neighbours(p, config.search, found);
+    }
     if (n == 0) return;
     ++out.num_inliers;
     for (int c = 0; c < n; ++c) {

@@ -79,9 +79,7 @@ NdtTarget NdtTarget::fromPoints(std::span<const Eigen::Vector3d> points, double 
   return NdtTarget(stats, cells);
 }
 
-int NdtTarget::neighbours(const Eigen::Vector3d& p, NeighbourSearch search,
-                          const NdtCell** out) const {
-  const VoxelKey key = voxelOf(p, inverse_resolution_);
+int NdtTarget::neighboursOf(VoxelKey key, NeighbourSearch search, const NdtCell** out) const {
   if (key == kInvalidVoxel) return 0;
   int n = 0;
   if (const std::int32_t i = index_.find(key); i >= 0) out[n++] = &cells_[i];

@@ -52,9 +52,9 @@ struct NdtConfig {
   /// A cell whose middle eigenvalue is below this share of its largest holds a line of points
   /// (one scan's ring across the ground, which moves with the sensor): not used; 0 keeps them.
   double line_cell_ratio = 0.02;
-  int max_iterations = 35;              ///< per resolution
-  double step_epsilon_m = 1e-3;         ///< converged when the translation step is below this...
-  double step_epsilon_rad = 1e-4;       ///< ...and the rotation step below this
+  int max_iterations = 35;         ///< per resolution
+  double step_epsilon_m = 1e-3;    ///< converged when the translation step is below this...
+  double step_epsilon_rad = 1e-4;  ///< ...and the rotation step below this
   /// A Newton step translating more than this many cell edges is scaled down (0.1 of a 1 m cell
   /// took 11 iterations from 0.5 m / 5 deg on the test pair, 0.5 took 19: the score is not
   /// convex far from the minimum, and long steps overshoot).
@@ -93,7 +93,15 @@ class NdtTarget {
   const std::vector<NdtCell>& cells() const { return cells_; }
   bool empty() const { return cells_.empty(); }
   /// Writes the cells near `p` into `out` (up to 7) and returns how many.
-  int neighbours(const Eigen::Vector3d& p, NeighbourSearch search, const NdtCell** out) const;
+  int neighbours(const Eigen::Vector3d& p, NeighbourSearch search, const NdtCell** out) const {
+    return neighboursOf(voxelOf(p), search, out);
+  }
+  /// The voxel of `p` in this target's cells (kInvalidVoxel far out or for NaN).
+  VoxelKey voxelOf(const Eigen::Vector3d& p) const {
+    return registration::voxelOf(p, inverse_resolution_);
+  }
+  /// The cells near the points of voxel `key`, as neighbours() gives them.
+  int neighboursOf(VoxelKey key, NeighbourSearch search, const NdtCell** out) const;
 
  private:
   double resolution_m_ = 1.0;
@@ -118,10 +126,25 @@ struct NdtDerivatives {
   std::size_t num_inliers = 0;
 };
 
-/// P2D cost at T_target_source; without the Hessian when `with_hessian` is false.
+/// The cells each source point was scored against, by the voxel it fell into, kept from one
+/// evaluation of a registration to the next: a Newton step moves most points by less than a cell,
+/// and the same voxel then gives the same cells without a hash lookup. One per source point, for
+/// one target only.
+struct NeighbourCache {
+  struct Entry {
+    VoxelKey key = kInvalidVoxel;  ///< no cell near an invalid voxel: a valid empty entry
+    int count = 0;
+    const NdtCell* cells[7] = {};
+  };
+  explicit NeighbourCache(std::size_t source_points) : entries(source_points) {}
+  std::vector<Entry> entries;
+};
+
+/// P2D cost at T_target_source; without the Hessian when `with_hessian` is false. `cache`, when
+/// given, has one entry per source point and was used with this target only.
 NdtDerivatives ndtDerivatives(std::span<const Eigen::Vector3d> source, const NdtTarget& target,
                               const lie::SE3& T_target_source, const NdtConfig& config,
-                              bool with_hessian = true);
+                              bool with_hessian = true, NeighbourCache* cache = nullptr);
 
 /// Source cells for D2D-NDT (mean and regularized covariance).
 struct D2dSource {
