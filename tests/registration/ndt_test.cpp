@@ -61,6 +61,28 @@ std::vector<Eigen::Vector3d> stablePoints(const lie::SE3& T, double resolution_m
   return out;
 }
 
+TEST(Ndt, TheNeighbourCacheGivesTheSameDerivativesAsLookingEveryCellUp) {
+  // Poses a few centimetres to decimetres apart, as Newton steps are: some points stay in their
+  // voxel (cached cells), some move on (looked up again), with one neighbour or seven.
+  const NdtTarget target = NdtTarget::fromPoints(data().target, 1.0);
+  std::mt19937 rng(3);
+  for (const NeighbourSearch search : {NeighbourSearch::kDirect1, NeighbourSearch::kDirect7}) {
+    NdtConfig config;
+    config.search = search;
+    NeighbourCache cache(data().source.size());
+    lie::SE3 T = data().T_target_source;
+    for (int step = 0; step < 6; ++step) {
+      T = T * test::randomPerturbation(rng, step < 3 ? 0.02 : 0.3, step < 3 ? 0.2 : 2.0);
+      const NdtDerivatives looked_up = ndtDerivatives(data().source, target, T, config);
+      const NdtDerivatives cached = ndtDerivatives(data().source, target, T, config, true, &cache);
+      EXPECT_EQ(cached.score, looked_up.score);
+      EXPECT_EQ(cached.gradient, looked_up.gradient);
+      EXPECT_EQ(cached.hessian, looked_up.hessian);
+      EXPECT_EQ(cached.num_inliers, looked_up.num_inliers);
+    }
+  }
+}
+
 TEST(Ndt, AnalyticGradientAndHessianMatchNumericalDifferentiation) {
   NdtConfig config;
   const NdtTarget target = NdtTarget::fromPoints(data().target, 1.0);
