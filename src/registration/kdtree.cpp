@@ -1,5 +1,6 @@
 #include "taiga/registration/kdtree.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <nanoflann.hpp>
@@ -83,9 +84,19 @@ bool KdTree::nearest(const Eigen::Vector3d& query, std::size_t& index,
 }
 
 bool KdTree::nearestWithin(const Eigen::Vector3d& query, double max_distance_m, std::size_t& index,
-                           double& squared_distance_m2) const {
+                           double& squared_distance_m2, std::size_t hint) const {
   if (impl_->points.empty()) return false;
-  NearestWithin result(max_distance_m * max_distance_m);
+  double bound_m2 = max_distance_m * max_distance_m;
+  if (hint < impl_->points.size()) {
+    // The hint's squared distance summed as nanoflann's L2_Simple_Adaptor sums it (axis by axis),
+    // so that the hint itself is within the bound (NearestWithin includes the bound).
+    const Eigen::Vector3d& p = impl_->points[hint];
+    double hint_m2 = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+      hint_m2 += (query[axis] - p[axis]) * (query[axis] - p[axis]);
+    bound_m2 = std::min(bound_m2, hint_m2);
+  }
+  NearestWithin result(bound_m2);
   impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
   if (!result.full()) return false;
   index = result.index();
@@ -98,17 +109,20 @@ Agreement agreement(std::span<const Eigen::Vector3d> source, const KdTree& targe
   struct Partial {
     double sum = 0.0;
     std::size_t count = 0;
+    std::size_t previous = KdTree::kNoHint;  ///< the block's previous query's nearest point
   };
   const Eigen::Matrix3d R = T_target_source.rotation().matrix();
   const Eigen::Vector3d t = T_target_source.translation();
   const Partial total = detail::reduceInBlocks<Partial>(
       source.size(),
       [&](std::size_t i, Partial& out) {
+        // The source comes in voxel order: the previous point's nearest is a near hint.
         std::size_t index;
         double sq;
-        if (target.nearestWithin(R * source[i] + t, max_distance_m, index, sq)) {
+        if (target.nearestWithin(R * source[i] + t, max_distance_m, index, sq, out.previous)) {
           out.sum += sq;
           ++out.count;
+          out.previous = index;
         }
       },
       [](Partial& a, const Partial& b) {
@@ -118,8 +132,8 @@ Agreement agreement(std::span<const Eigen::Vector3d> source, const KdTree& targe
   Agreement a;
   a.fitness_m2 = total.count == 0 ? std::numeric_limits<double>::quiet_NaN()
                                   : total.sum / static_cast<double>(total.count);
-  a.share = source.empty() ? 0.0
-                           : static_cast<double>(total.count) / static_cast<double>(source.size());
+  a.share =
+      source.empty() ? 0.0 : static_cast<double>(total.count) / static_cast<double>(source.size());
   return a;
 }
 

@@ -137,12 +137,20 @@ TEST(KdTree, NearestWithinARadiusIsTheNearestPointWhenItLiesWithin) {
     double nearest_sq = 0.0, bounded_sq = 0.0;
     ASSERT_TRUE(tree.nearest(query, nearest, nearest_sq));
     const double radius_m = 0.5;
+    // A hint (any point: near, far, the nearest itself) only shortens the search.
+    const std::size_t hint = q % 3 == 0 ? nearest : static_cast<std::size_t>(rng() % points.size());
+    std::size_t hinted = 0;
+    double hinted_sq = 0.0;
+    const bool hinted_found = tree.nearestWithin(query, radius_m, hinted, hinted_sq, hint);
     if (tree.nearestWithin(query, radius_m, bounded, bounded_sq)) {
       ++within;
       EXPECT_EQ(bounded, nearest);
       EXPECT_EQ(bounded_sq, nearest_sq);
       EXPECT_LE(bounded_sq, radius_m * radius_m);
+      ASSERT_TRUE(hinted_found);
+      EXPECT_EQ(hinted_sq, nearest_sq);
     } else {
+      EXPECT_FALSE(hinted_found);
       ++beyond;
       EXPECT_GT(nearest_sq, radius_m * radius_m);
     }

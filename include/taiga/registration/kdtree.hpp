@@ -29,8 +29,12 @@ class KdTree {
   bool nearest(const Eigen::Vector3d& query, std::size_t& index, double& squared_distance_m2) const;
   /// The nearest point if it lies within max_distance_m (inclusive): the same point as nearest(),
   /// but the search stops at that radius, so a query far from every point costs little.
+  /// `hint`, when not kNoHint, is a point index; the search then starts from its distance (if
+  /// within the radius) instead of the radius: the same distance found, faster when the hint
+  /// is near (e.g. the previous query's nearest point, for queries in spatial order).
   bool nearestWithin(const Eigen::Vector3d& query, double max_distance_m, std::size_t& index,
-                     double& squared_distance_m2) const;
+                     double& squared_distance_m2, std::size_t hint = kNoHint) const;
+  static constexpr std::size_t kNoHint = static_cast<std::size_t>(-1);
 
  private:
   struct Impl;
