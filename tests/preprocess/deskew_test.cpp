@@ -26,6 +26,14 @@ lie::SE3 truePose(double t) {
   return lie::SE3(s.R_world_body, s.p_world);
 }
 
+/// The true poses at 400 Hz over the sweep and 10 ms either side.
+Trajectory trueSweep() {
+  Trajectory trajectory;
+  for (double t = kScanStart - 0.01; t <= kScanStart + kScanPeriod + 0.01; t += 0.0025)
+    trajectory.append(t, truePose(t));
+  return trajectory;
+}
+
 /// Static world points seen by the moving lidar, each at a random column's firing time.
 struct SimulatedScan {
   std::vector<Eigen::Vector3d> points_in_world;
@@ -65,9 +73,7 @@ double worldError(const SimulatedScan& scan, const DeskewedScan& deskewed) {
 
 TEST(Deskew, PutsEveryPointWhereItWasWithTheTrueTrajectory) {
   const SimulatedScan scan = simulateScan(5000);
-  Trajectory trajectory;
-  for (double t = kScanStart - 0.01; t <= kScanStart + kScanPeriod + 0.01; t += 0.0025)
-    trajectory.append(t, truePose(t));
+  const Trajectory trajectory = trueSweep();
   const double t_ref = kScanStart + kScanPeriod;
   const DeskewedScan deskewed = deskew(scan.cloud_in_lidar, kT_body_lidar, trajectory, t_ref);
   EXPECT_EQ(deskewed.clamped_points, 0u);
@@ -107,9 +113,7 @@ TEST(Deskew, AColumnChannelChangesNothingEvenWhenItDisagreesWithTheTimes) {
   // deskew guesses a point's time from its column's previous one, checked bit for bit: a column
   // channel that matches the times, or one that does not, gives the same points as none.
   const SimulatedScan scan = simulateScan(5000);
-  Trajectory trajectory;
-  for (double t = kScanStart - 0.01; t <= kScanStart + kScanPeriod + 0.01; t += 0.0025)
-    trajectory.append(t, truePose(t));
+  const Trajectory trajectory = trueSweep();
   const double t_ref = kScanStart + kScanPeriod;
   const PointCloud plain =
       deskew(scan.cloud_in_lidar, kT_body_lidar, trajectory, t_ref).cloud_in_body;
