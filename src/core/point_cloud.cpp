@@ -25,6 +25,15 @@ void selectChannel(const std::vector<T>& from, std::span<const std::size_t> indi
   for (std::size_t i : indices) into.push_back(from[i]);
 }
 
+template <class T>
+void keepChannel(std::vector<T>& channel, std::span<const std::uint8_t> keep) {
+  if (channel.empty()) return;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < channel.size(); ++i)
+    if (keep[i]) channel[kept++] = channel[i];
+  channel.resize(kept);
+}
+
 }  // namespace
 
 bool PointCloud::isConsistent() const {
@@ -74,6 +83,15 @@ PointCloud PointCloud::select(std::span<const std::size_t> indices) const {
   selectChannel(rings, indices, out.rings);
   selectChannel(columns, indices, out.columns);
   return out;
+}
+
+void PointCloud::keepWhere(std::span<const std::uint8_t> keep) {
+  assert(isConsistent() && keep.size() == size());
+  keepChannel(positions, keep);
+  keepChannel(times_s, keep);
+  keepChannel(intensities, keep);
+  keepChannel(rings, keep);
+  keepChannel(columns, keep);
 }
 
 std::pair<double, double> PointCloud::timeSpan() const {

@@ -17,6 +17,19 @@ PointCloud makeCloud(int n, double t0) {
   return cloud;
 }
 
+TEST(PointCloud, KeepWhereCompactsEveryChannelInOrder) {
+  PointCloud cloud = makeCloud(6, 10.0);
+  cloud.intensities = {0, 1, 2, 3, 4, 5};
+  const PointCloud expected = cloud.select(std::vector<std::size_t>{1, 2, 5});
+  cloud.keepWhere(std::vector<std::uint8_t>{0, 1, 1, 0, 0, 1});
+  EXPECT_TRUE(cloud.isConsistent());
+  EXPECT_EQ(cloud.positions, expected.positions);
+  EXPECT_EQ(cloud.times_s, expected.times_s);
+  EXPECT_EQ(cloud.intensities, expected.intensities);
+  EXPECT_EQ(cloud.rings, expected.rings);
+  EXPECT_TRUE(cloud.columns.empty());  // absent channels stay absent
+}
+
 TEST(PointCloud, ChannelsAreOptionalButMustMatchTheSize) {
   PointCloud cloud = makeCloud(5, 0.0);
   EXPECT_TRUE(cloud.isConsistent());

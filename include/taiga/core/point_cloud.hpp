@@ -35,6 +35,9 @@ struct PointCloud {
   void append(const PointCloud& other);
   /// The points at `indices`, in that order, with all channels.
   PointCloud select(std::span<const std::size_t> indices) const;
+  /// Keeps, in place and in order, the points whose `keep` entry (one per point) is non-zero,
+  /// with all channels.
+  void keepWhere(std::span<const std::uint8_t> keep);
   /// Earliest and latest per-point time; requires hasTimes() and a non-empty cloud.
   std::pair<double, double> timeSpan() const;
 };
