@@ -92,7 +92,8 @@ InitialState initializeFromImu(std::span<const ImuSample> samples,
   init.covariance.setZero();
   init.covariance.diagonal() << Vector3::Constant(1e-6), tilt_sigma * tilt_sigma,
       tilt_sigma * tilt_sigma, 1e-6, Vector3::Constant(velocity_sigma * velocity_sigma),
-      Vector3::Constant(0.05 * 0.05), Vector3::Constant(gyro_bias_sigma * gyro_bias_sigma);
+      Vector3::Constant(kStartAccelBiasSigma_mps2 * kStartAccelBiasSigma_mps2),
+      Vector3::Constant(gyro_bias_sigma * gyro_bias_sigma);
 
   const Matrix3 R = init.state.R_world_body.matrix();
   const Vector3 rpy_deg =

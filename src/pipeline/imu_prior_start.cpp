@@ -163,7 +163,8 @@ std::optional<lie::SE3> ImuPrior::levelFrame() {
   levelled.bias.accel_mps2 = a.accel_bias_mps2;
   levelled.covariance.block<3, 15>(9, 0).setZero();
   levelled.covariance.block<15, 3>(0, 9).setZero();
-  levelled.covariance.block<3, 3>(9, 9) = Eigen::Matrix3d::Identity() * 0.05 * 0.05;
+  levelled.covariance.block<3, 3>(9, 9) =
+      Eigen::Matrix3d::Identity() * imu::kStartAccelBiasSigma_mps2 * imu::kStartAccelBiasSigma_mps2;
   smoother_.initialize(levelled);
   const double tilt_deg =
       std::acos(std::clamp(a.gravity_world.normalized().z() * -1.0, -1.0, 1.0)) / kRadPerDeg;

@@ -30,6 +30,9 @@ struct InitializationConfig {
   double gravity_mps2 = 9.81;
 };
 
+/// 1-sigma of the accelerometer bias a start assumes (a turn-on bias of a MEMS IMU), m/s^2.
+inline constexpr double kStartAccelBiasSigma_mps2 = 0.05;
+
 struct InitialState {
   double t_s = 0.0;  ///< time of the last reading used
   NavState state;
