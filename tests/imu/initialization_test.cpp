@@ -66,22 +66,45 @@ TEST(Initialization, MovingFromTheStartGivesAnApproximateTiltAndLoosePriors) {
   EXPECT_GE(init.covariance(3, 3), std::pow(2.0 * kRadPerDeg, 2));
 }
 
-TEST(Initialization, UsesAnEnuOrientationWholeAndTurnsNedIntoEnu) {
-  const lie::SO3 R_enu_imu =
-      lie::SO3::fromRollPitchYaw(3 * kRadPerDeg, 2 * kRadPerDeg, 70 * kRadPerDeg);
-  std::vector<ImuSample> samples = restingSamples(R_enu_imu, Vector3::Zero());
+TEST(Initialization, MovingUsesAnEnuOrientationWholeAndTurnsNedIntoEnu) {
+  std::vector<ImuSample> samples;
+  for (int k = 0; k < 400; ++k) {
+    const double t = k * 0.005;
+    samples.push_back({t, test::WavyMotion::accel(t), test::WavyMotion::gyro(t), {}});
+  }
+  // The orientation output tells the attitude at each reading; the state is the last one's.
+  const auto R_enu_imu = [](double t_s) { return test::WavyMotion::state(t_s).R_world_body; };
   for (ImuSample& s : samples)
-    s.orientation = ImuOrientation{R_enu_imu.quaternion(), OrientationReference::kEnu};
+    s.orientation = ImuOrientation{R_enu_imu(s.t_s).quaternion(), OrientationReference::kEnu};
   const InitialState from_enu = initializeFromImu(samples);
+  EXPECT_FALSE(from_enu.at_rest);
   EXPECT_TRUE(from_enu.from_orientation);
-  EXPECT_LT((from_enu.state.R_world_body.inverse() * R_enu_imu).angle(), 1e-9);
+  EXPECT_LT((from_enu.state.R_world_body.inverse() * R_enu_imu(from_enu.t_s)).angle(), 1e-9);
 
   Matrix3 R_ned_enu;
   R_ned_enu << 0, 1, 0, 1, 0, 0, 0, 0, -1;
-  const lie::SO3 R_ned_imu = lie::SO3::fromMatrix(R_ned_enu * R_enu_imu.matrix());
-  for (ImuSample& s : samples)
+  for (ImuSample& s : samples) {
+    const lie::SO3 R_ned_imu = lie::SO3::fromMatrix(R_ned_enu * R_enu_imu(s.t_s).matrix());
     s.orientation = ImuOrientation{R_ned_imu.quaternion(), OrientationReference::kNed};
-  EXPECT_LT((initializeFromImu(samples).state.R_world_body.inverse() * R_enu_imu).angle(), 1e-9);
+  }
+  const InitialState from_ned = initializeFromImu(samples);
+  EXPECT_LT((from_ned.state.R_world_body.inverse() * R_enu_imu(from_ned.t_s)).angle(), 1e-9);
+}
+
+TEST(Initialization, AtRestTheTiltComesFromTheAccelerometerAndTheHeadingFromTheOrientation) {
+  const double roll = 3 * kRadPerDeg, pitch = 2 * kRadPerDeg, yaw = 70 * kRadPerDeg;
+  const lie::SO3 R_enu_imu = lie::SO3::fromRollPitchYaw(roll, pitch, yaw);
+  std::vector<ImuSample> samples = restingSamples(R_enu_imu, Vector3::Zero());
+  // An orientation filter's tilt a degree off, as the simulated 9-axis IMUs' are.
+  const lie::SO3 R_output =
+      lie::SO3::fromRollPitchYaw(roll + 1 * kRadPerDeg, pitch - 1 * kRadPerDeg, yaw);
+  for (ImuSample& s : samples)
+    s.orientation = ImuOrientation{R_output.quaternion(), OrientationReference::kEnu};
+  const InitialState init = initializeFromImu(samples);
+  EXPECT_TRUE(init.at_rest);
+  EXPECT_TRUE(init.from_orientation);
+  EXPECT_LT(tiltError(init.state.R_world_body, R_enu_imu), 0.05 * kRadPerDeg);
+  EXPECT_NEAR(init.state.R_world_body.yaw(), yaw, 0.01 * kRadPerDeg);
 }
 
 TEST(Initialization, AccelerationsInGAndTooFewReadingsAreClearErrors) {
