@@ -5,6 +5,7 @@
 #include <ceres/solver.h>
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -93,6 +94,27 @@ double PoseGraph::addLoopIfConsistent(const RelativePose& loop, double max_chi2)
   const double chi2 = 2.0 * (trial.optimize() - cost_);
   if (chi2 <= max_chi2) *this = std::move(trial);
   return chi2;
+}
+
+double PoseGraph::loopPairChi2(const RelativePose& first, const RelativePose& second) const {
+  const std::size_t a = first.from, b = first.to, c = second.from, d = second.to;
+  if (segments_[a] != segments_[c] || segments_[b] != segments_[d])
+    return std::numeric_limits<double>::infinity();
+  const RelativePose ac = odometryBetween(a, c), bd = odometryBetween(b, d);
+  // Both ways from a to d: T_ab T_bd and T_ac T_cd. With every relative pose perturbed on the
+  // right (T Exp(e)), the cycle C = T_bd^-1 T_ab^-1 T_ac T_cd moves by
+  //   e_cd + Adj(T_cd^-1) e_ac - Adj(Y^-1) e_ab - Adj(C^-1) e_bd,   Y = T_ab^-1 T_ac T_cd.
+  const lie::SE3& T_ab = first.T_from_to;
+  const lie::SE3& T_cd = second.T_from_to;
+  const lie::SE3 Y = T_ab.inverse() * ac.T_from_to * T_cd;
+  const lie::SE3 C = bd.T_from_to.inverse() * Y;
+  const lie::Matrix6 A_ac = T_cd.inverse().adjoint(), A_ab = Y.inverse().adjoint(),
+                     A_bd = C.inverse().adjoint();
+  const lie::Matrix6 covariance = second.covariance + A_ac * ac.covariance * A_ac.transpose() +
+                                  A_ab * first.covariance * A_ab.transpose() +
+                                  A_bd * bd.covariance * A_bd.transpose();
+  const lie::Vector6 e = C.Log();
+  return e.dot(covariance.ldlt().solve(e));
 }
 
 void PoseGraph::addPosition(std::size_t keyframe, const Eigen::Vector3d& p_map,

@@ -38,14 +38,15 @@ std::vector<lie::SE3> trueSquareWalk(int keyframes) {
   return T_world_body;
 }
 
-// The odometry of it: 0.015 deg/m heading drift and 0.3 % long steps.
-std::vector<lie::SE3> driftingOdometry(const std::vector<lie::SE3>& T_world_body_true) {
+// The odometry of it: 0.015 deg/m heading drift (or `deg_per_m`) and 0.3 % long steps.
+std::vector<lie::SE3> driftingOdometry(const std::vector<lie::SE3>& T_world_body_true,
+                                       double deg_per_m = 0.015) {
   std::vector<lie::SE3> T_odom_body{T_world_body_true.front()};
   for (std::size_t k = 1; k < T_world_body_true.size(); ++k) {
     const lie::SE3 step = T_world_body_true[k - 1].inverse() * T_world_body_true[k];
     T_odom_body.push_back(
         T_odom_body.back() *
-        lie::SE3(step.rotation() * lie::SO3::Exp(Eigen::Vector3d(0, 0, 0.015 * kRadPerDeg)),
+        lie::SE3(step.rotation() * lie::SO3::Exp(Eigen::Vector3d(0, 0, deg_per_m * kRadPerDeg)),
                  step.translation() * 1.003));
   }
   return T_odom_body;
@@ -182,6 +183,59 @@ TEST_F(MapperWithAStandInVerifier, SpacesItsAttemptsByTheMinimumIntervalOfKeyfra
     EXPECT_EQ(mapper.loopAttempts()[i].attempt.note, "stand-in: rejected");
   }
   EXPECT_EQ(mapper.loopClosures(), 0u);
+}
+
+// A rig whose odometry drifts more than the graph's sigmas allow (0.03 deg/m): its true loops
+// are disputed by the graph, but two that agree with each other are both kept.
+TEST_F(MapperWithAStandInVerifier, KeepsTwoDisputedLoopsThatAgreeWithEachOther) {
+  const std::vector<lie::SE3> T_odom_body = driftingOdometry(T_world_body_true_, 0.03);
+  Mapper mapper(config_, OdometryConfig{}, store_,
+                reportTrueLoop(T_world_body_true_, lie::SE3(), &asked_));
+  for (std::size_t k = 0; k < T_odom_body.size(); ++k)
+    mapper.addKeyframe(k, secondsOf(k), T_odom_body[k]);
+  const std::vector<LoopRecord>& attempts = mapper.loopAttempts();
+  ASSERT_GE(attempts.size(), 2u);
+  // Each alone is beyond the limit; the second finds the first agreeing and both are kept.
+  EXPECT_GT(attempts[0].chi2, config_.loop_max_chi2);
+  EXPECT_GT(attempts[1].chi2, config_.loop_max_chi2);
+  EXPECT_TRUE(attempts[0].attempt.accepted);
+  EXPECT_TRUE(attempts[1].attempt.accepted);
+  EXPECT_THAT(attempts[1].attempt.note,
+              StartsWith("accepted with the loop at keyframe " + std::to_string(asked_[0])));
+  ASSERT_GE(mapper.loopClosures(), 2u);
+  const std::size_t second = asked_[1];
+  const double drift_m = distanceM(T_odom_body[second], T_world_body_true_[second]);
+  ASSERT_GT(drift_m, 2.0);
+  EXPECT_LT(distanceM(mapper.graph().pose(second), T_world_body_true_[second]), 0.05 * drift_m);
+}
+
+// The same rig, with its first loop a registration's wrong minimum half a metre to the side: the
+// next (true) loop does not agree with it, and the one after agrees with the next; the false
+// loop is never kept.
+TEST_F(MapperWithAStandInVerifier, NeverPairsADisputedLoopWithOneThatContradictsIt) {
+  const std::vector<lie::SE3> T_odom_body = driftingOdometry(T_world_body_true_, 0.03);
+  const LoopVerifier truth = reportTrueLoop(T_world_body_true_, lie::SE3(), &asked_);
+  const LoopVerifier half_metre_off = reportTrueLoop(
+      T_world_body_true_, lie::SE3::Exp((lie::Vector6() << 0, 0.5, 0, 0, 0, 0).finished()),
+      &asked_);
+  int calls = 0;
+  Mapper mapper(config_, OdometryConfig{}, store_,
+                [&](const PoseGraph& graph, const KeyframeStore& store, std::size_t current,
+                    const LoopCandidate& candidate, const MappingConfig& config,
+                    const OdometryConfig& odometry) {
+                  return (calls++ == 0 ? half_metre_off : truth)(graph, store, current, candidate,
+                                                                 config, odometry);
+                });
+  for (std::size_t k = 0; k < T_odom_body.size(); ++k)
+    mapper.addKeyframe(k, secondsOf(k), T_odom_body[k]);
+  const std::vector<LoopRecord>& attempts = mapper.loopAttempts();
+  ASSERT_GE(attempts.size(), 3u);
+  EXPECT_FALSE(attempts[0].attempt.accepted);
+  EXPECT_THAT(attempts[0].attempt.note, StartsWith("inconsistent with the graph"));
+  EXPECT_TRUE(attempts[2].attempt.accepted);
+  EXPECT_THAT(attempts[2].attempt.note,
+              StartsWith("accepted with the loop at keyframe " + std::to_string(asked_[1])));
+  for (const RelativePose& loop : mapper.graph().loops()) EXPECT_NE(loop.to, asked_[0]);
 }
 
 TEST_F(MapperWithAStandInVerifier, MakesNoAttemptWithLoopClosureOff) {

@@ -114,5 +114,23 @@ TEST(PoseGraph, PositionFactorsPlaceTheGraph) {
     EXPECT_LT((graph.pose(k).translation() - truth[k].translation() - shift).norm(), 0.01) << k;
 }
 
+// Two loops agree with each other over the short odometry between their ends however far the
+// odometry drifted around the loop; one half a metre off does not; odometry across map segments
+// says nothing.
+TEST(PoseGraph, TwoLoopsAgreeOverTheShortOdometryBetweenTheirEnds) {
+  const std::vector<lie::SE3> truth = trueSquareLoop();
+  const PoseGraph graph = graphOf(driftingOdometry(truth));
+  const RelativePose first = loopFromTruth(truth, 0, 150), second = loopFromTruth(truth, 3, 153);
+  EXPECT_LT(graph.loopPairChi2(first, second), 3.0);
+  RelativePose off = second;
+  off.T_from_to = off.T_from_to * lie::SE3::Exp((lie::Vector6() << 0, 0.5, 0, 0, 0, 0).finished());
+  EXPECT_GT(graph.loopPairChi2(first, off), 100.0);
+
+  PoseGraph segmented{MappingConfig{}};
+  const std::vector<lie::SE3> odometry = driftingOdometry(truth);
+  for (std::size_t k = 0; k < odometry.size(); ++k) segmented.addKeyframe(odometry[k], k < 152);
+  EXPECT_TRUE(std::isinf(segmented.loopPairChi2(first, second)));
+}
+
 }  // namespace
 }  // namespace taiga::mapping

@@ -90,6 +90,11 @@ class Mapper {
 
  private:
   void tryLoopClosure(std::size_t current, double t_s);
+  /// A verified loop that the graph disputes (chi2 above loop_max_chi2, within
+  /// kLoopPairMaxGraphChi2Factor times it) is kept when an earlier such loop, within
+  /// kLoopPairKeyframes, agrees with it (PoseGraph::loopPairChi2 within loop_max_chi2); both
+  /// are then added. Returns whether it was.
+  bool acceptWithAgreeingLoop(LoopRecord& record);
   void tryRelocalization(std::size_t current, double t_s);
   /// Whether a later segment still looks for links to the map rather than loops: until it is
   /// attached, and then for more links (one registration's heading error would swing the whole
@@ -105,6 +110,9 @@ class Mapper {
   std::optional<GnssFusion> gnss_;
   std::optional<double> last_attempt_s_;
   std::vector<LoopRecord> attempts_;
+  std::vector<std::size_t> disputed_loops_;  ///< attempts_ verified but refused by the graph
+  static constexpr std::size_t kLoopPairKeyframes = 30;
+  static constexpr double kLoopPairMaxGraphChi2Factor = 4.0;
   static constexpr int kSegmentLinks = 3;
   static constexpr std::size_t kSegmentLinkKeyframes = 20;
   struct SegmentLinks {

@@ -66,6 +66,12 @@ class PoseGraph {
   /// Mahalanobis distance against the odometry's accumulated uncertainty; a false one bends the
   /// graph and costs far more. Returns that chi^2; the graph is unchanged when it is above.
   double addLoopIfConsistent(const RelativePose& loop, double max_chi2);
+  /// How well two loops agree with each other, whatever the long stretch of odometry between
+  /// their ends says (pairwise consistency, after Mangelson et al. 2018, "PCM"): chi^2 (6 degrees
+  /// of freedom) of the cycle first.from -> first.to -> second.to -> second.from -> first.from,
+  /// whose odometry is only the short stretches between the loops' ends. Infinity when such a
+  /// stretch crosses map segments.
+  double loopPairChi2(const RelativePose& first, const RelativePose& second) const;
   /// An absolute position of a keyframe in the map frame (m) with its covariance (m^2);
   /// `huber_sigmas` > 0 makes the factor robust beyond that many sigmas.
   void addPosition(std::size_t keyframe, const Eigen::Vector3d& p_map,
