@@ -67,7 +67,7 @@ std::string HealthMonitor::limitProblems(const HealthEvidence& scan, bool& impos
   if (scan.estimates_bias) {
     const double accel_bias_mps2 = scan.bias.accel_mps2.norm();
     const double gyro_bias_dps = scan.bias.gyro_radps.norm() * kDegPerRad;
-    if (accel_bias_mps2 > config_.max_accel_bias_mps2)
+    if (scan.frame_levelled && accel_bias_mps2 > config_.max_accel_bias_mps2)
       append(reasons, fmt::format("accelerometer bias estimate {:.2f} m/s^2 is implausible",
                                   accel_bias_mps2));
     if (gyro_bias_dps > config_.max_gyro_bias_dps)

@@ -34,6 +34,10 @@ struct HealthEvidence {
   Eigen::Vector3d v_odom = Eigen::Vector3d::Zero();
   imu::ImuBias bias;
   bool estimates_bias = false;
+  /// Until the IMU's gravity alignment levels the odom frame, the accelerometer bias absorbs the
+  /// start frame's tilt error by design (3.8 m/s^2 for a walk that starts in a U-turn: 22 deg),
+  /// so it is judged only after.
+  bool frame_levelled = true;
   double imu_gap_s = 0.0;  ///< the longest stretch without IMU readings before the scan, s
   /// Registered from near the last keyframe's own viewpoint (standing, or just after a
   /// keyframe): it matches mostly the points it was made of, so its fitness says nothing of what

@@ -261,6 +261,7 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
        .v_odom = outcome.v_odom,
        .bias = outcome.bias,
        .estimates_bias = !lidar_only_,
+       .frame_levelled = motion_->levelled(),
        .imu_gap_s = outcome.imu_gap_s,
        .at_keyframe_viewpoint = fromLastKeyframe_m(outcome.T_odom_body) <
                                 kKeyframeViewpointShare * config_.keyframe_distance_m});

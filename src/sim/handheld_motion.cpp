@@ -27,6 +27,8 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 /// Harmonics of the arc-length correction g(v).
 constexpr int kArcHarmonics = 64;
+// A stadium's ends (loop_straightness > 0) turn the arc length's rate over u sharply: more terms.
+constexpr int kStadiumArcHarmonics = 256;
 
 class HandheldMotion final : public TrajectoryModel {
  public:
@@ -68,7 +70,8 @@ class HandheldMotion final : public TrajectoryModel {
   double omega_ = 0.1;           ///< W, rad/s
   int speed_harmonic_ = 1;       ///< m
   double phases_[6]{};           ///< gait and look-around phases
-  double arc_cos_[kArcHarmonics + 1]{}, arc_sin_[kArcHarmonics + 1]{};
+  int arc_harmonics_ = kArcHarmonics;
+  double arc_cos_[kStadiumArcHarmonics + 1]{}, arc_sin_[kStadiumArcHarmonics + 1]{};
   PlateauTrain pauses_;  ///< unit plateaus: the share of standing still
   PlateauTrain turns_;   ///< plateaus of yaw offset, rad
 };
@@ -163,7 +166,8 @@ void HandheldMotion::fitArcLength() {
     const double u = 2.0 * kPi * (j + f) / kGrid;
     g[k] = u - 2.0 * kPi * k / kSamples;
   }
-  for (int h = 0; h <= kArcHarmonics; ++h) {
+  arc_harmonics_ = params_.loop_straightness > 0.0 ? kStadiumArcHarmonics : kArcHarmonics;
+  for (int h = 0; h <= arc_harmonics_; ++h) {
     double ca = 0.0, sa = 0.0;
     for (int k = 0; k < kSamples; ++k) {
       const double v = 2.0 * kPi * k / kSamples;
@@ -176,7 +180,7 @@ void HandheldMotion::fitArcLength() {
   arc_sin_[0] = 0.0;
   arc_cos_[0] -= arcCorrection(0.0).v;  // u(0) = 0 exactly: the walk starts at the start
   for (int k = 0; k < 1000; ++k) {
-    if (1.0 + arcCorrection(2.0 * kPi * k / 1000).d < 0.2)
+    if (1.0 + arcCorrection(2.0 * kPi * k / 1000).d < 0.1)
       throw std::logic_error("handheld motion: arc-length reparametrization is not monotonic");
   }
 }
@@ -185,7 +189,7 @@ Jet HandheldMotion::arcCorrection(double v) const {
   Jet g{arc_cos_[0], 0.0, 0.0};
   const std::complex<double> step(std::cos(v), std::sin(v));
   std::complex<double> e = step;  // exp(i h v), by recurrence
-  for (int h = 1; h <= kArcHarmonics; ++h, e *= step) {
+  for (int h = 1; h <= arc_harmonics_; ++h, e *= step) {
     const double c = e.real(), s = e.imag();
     g.v += arc_cos_[h] * c + arc_sin_[h] * s;
     g.d += h * (-arc_cos_[h] * s + arc_sin_[h] * c);
@@ -202,6 +206,22 @@ void HandheldMotion::curve(double u, Eigen::Vector2d* c, Eigen::Vector2d* dc,
     x = rx_m_ * std::cos(u), y = ry_m_ * std::sin(u);
     dx = -rx_m_ * std::sin(u), dy = ry_m_ * std::cos(u);
     ddx = -rx_m_ * std::cos(u), ddy = -ry_m_ * std::sin(u);
+    if (params_.loop_straightness > 0.0) {
+      // A stadium: x = (Rx - Ry) S(u) + Ry cos u with S = tanh(k cos u) / tanh(k), which is 1
+      // near u = 0 (the end is then the half circle of radius Ry around Rx - Ry) and sweeps to
+      // -1 along the sides. An ellipse this thin turns on a radius of Ry^2 / Rx.
+      const double k = params_.loop_straightness, T = std::tanh(k);
+      const double w = k * std::cos(u), dw = -k * std::sin(u), ddw = -k * std::cos(u);
+      const double th = std::tanh(w), sech2 = 1.0 - th * th;
+      const double S = th / T, dS = sech2 * dw / T, ddS = sech2 * (ddw - 2.0 * th * dw * dw) / T;
+      x = (rx_m_ - ry_m_) * S + ry_m_ * std::cos(u);
+      dx = (rx_m_ - ry_m_) * dS - ry_m_ * std::sin(u);
+      ddx = (rx_m_ - ry_m_) * ddS - ry_m_ * std::cos(u);
+      // Wiggles along x of Rx's size would swing the ends back and forth faster than the walk
+      // turns there (a 0.1 m radius at walking speed): along the straight sides they only vary
+      // the pace, so they take the ends' size.
+      wiggle_x = ry_m_;
+    }
   } else {
     const double n = params_.loop_lobes, kappa = params_.loop_lobes % 2 == 1 ? 0.5 : 1.0;
     const double e = params_.lobe_size_variation, h = 0.5 * n;

@@ -19,6 +19,8 @@ void MotionParams::validate() const {
   require(sensor_height_m > 0.0, "sensor_height_m", "> 0", sensor_height_m);
   require(loop_lobes == 1 || loop_lobes == 3 || loop_lobes == 4, "loop_lobes", "1, 3 or 4",
           loop_lobes);
+  require(loop_straightness >= 0.0 && loop_straightness <= 6.0, "loop_straightness", "0 .. 6",
+          loop_straightness);
   require(lobe_size_variation >= 0.0 && lobe_size_variation <= 0.6, "lobe_size_variation",
           "0 .. 0.6", lobe_size_variation);
   require(speed_variation >= 0.0 && speed_variation < 0.9, "speed_variation", "0 .. 0.9",

@@ -50,7 +50,8 @@ void openField(Scenario& s) {
 void stripRoad(Scenario& s) {
   s.forest.stems_per_ha = 900;
   s.forest.road_half_width_m = 2.5;
-  s.motion.loop_aspect = 0.04;  // out along one wheel track, back along the other
+  s.motion.loop_aspect = 0.06;  // out along one wheel track, back along the other
+  s.motion.loop_straightness = 4.0;  // and a U-turn of about 1 m radius at each end
   s.motion.look_around_deg = 12.0;
 }
 

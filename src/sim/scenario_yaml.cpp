@@ -118,6 +118,8 @@ const Field<MotionParams> kMotionFields[] = {
     {"speed_mps", &MotionParams::speed_mps, "mean walking speed, m/s"},
     {"sensor_height_m", &MotionParams::sensor_height_m, "sensor (body) height above ground, m"},
     {"loop_aspect", &MotionParams::loop_aspect, "loop's y radius / x radius"},
+    {"loop_straightness", &MotionParams::loop_straightness,
+     "0: an elliptic loop; k > 0: straight sides, ends of radius about Ry"},
     {"max_loop_length_m", &MotionParams::max_loop_length_m, "longer recordings repeat the loop, m"},
     {"shape_perturbation", &MotionParams::shape_perturbation, "relative loop wiggles"},
     {"loop_lobes", &MotionParams::loop_lobes, "1: one loop; 3, 4, 5: a cloverleaf"},
