@@ -50,7 +50,7 @@ struct MotionParams {
   double loop_aspect = 1.0;            ///< loop's y radius / x radius (strip road: thin loop)
   /// 0: the loop is an ellipse (whose ends turn on a radius of Ry^2 / Rx: 3 cm on the strip
   /// road's); k > 0: a stadium whose sides straighten with k and whose ends are half circles of
-  /// radius about Ry (k = 4: 0.97 Ry), handheld_motion.cpp
+  /// radius about Ry (k = 4: 0.9 Ry), handheld_motion.cpp
   double loop_straightness = 0.0;
   double max_loop_length_m = 300.0;    ///< longer recordings walk the loop again
   double shape_perturbation = 0.18;    ///< relative amplitude of the loop's wiggles
