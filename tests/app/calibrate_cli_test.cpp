@@ -23,18 +23,26 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Not;
 
+/// `taiga simulate SIMULATE_ARGS` into DIR/sim, then `taiga calibrate` of its recording with its
+/// rig.yaml into DIR/calibrated (plus CALIBRATE_ARGS); `result` is the calibration's.
+void simulateAndCalibrate(const test::TempDir& dir, const std::string& simulate_args,
+                          const std::string& calibrate_args, test::TaigaResult* result) {
+  const auto sim = dir.file("sim");
+  const test::TaigaResult simulated =
+      test::runTaiga("simulate " + simulate_args + " --out " + sim.string());
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  *result = test::runTaiga("calibrate " + (sim / "recording.bag").string() + " --config " +
+                           (sim / "rig.yaml").string() + " --out " +
+                           dir.file("calibrated").string() + calibrate_args);
+}
+
 TEST(CalibrateCli, FindsTheTimeOffsetAndRotationOfATypicalRig) {
   test::TempDir dir;
+  test::TaigaResult r;
+  ASSERT_NO_FATAL_FAILURE(simulateAndCalibrate(
+      dir, "--scenario handheld-loop --realism typical --duration 20 --beams 32 --seed 5", "", &r));
   const auto sim = dir.file("sim");
-  ASSERT_EQ(test::runTaiga("simulate --scenario handheld-loop --realism typical --duration 20 "
-                           "--beams 32 --seed 5 --out " +
-                           sim.string())
-                .exit_code,
-            0);
   const auto out = dir.file("calibrated");
-  const test::TaigaResult r =
-      test::runTaiga("calibrate " + (sim / "recording.bag").string() + " --config " +
-                     (sim / "rig.yaml").string() + " --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("offset     rig.lidar_time_offset_s"));
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "calibration.json"));
@@ -98,16 +106,11 @@ TEST(CalibrateCli, FindsTheTimeOffsetAndRotationOfATypicalRig) {
 // not see (14 deg on the 60 s recording of the same seed).
 TEST(CalibrateCli, ARigThatBarelyTurnsKeepsItsConfiguredRotation) {
   test::TempDir dir;
-  const auto sim = dir.file("sim");
-  ASSERT_EQ(test::runTaiga("simulate --scenario harvester --realism typical --duration 20 "
-                           "--beams 32 --seed 31 --out " +
-                           sim.string())
-                .exit_code,
-            0);
+  test::TaigaResult r;
+  ASSERT_NO_FATAL_FAILURE(simulateAndCalibrate(
+      dir, "--scenario harvester --realism typical --duration 20 --beams 32 --seed 31",
+      " --no-plots", &r));
   const auto out = dir.file("calibrated");
-  const test::TaigaResult r =
-      test::runTaiga("calibrate " + (sim / "recording.bag").string() + " --config " +
-                     (sim / "rig.yaml").string() + " --out " + out.string() + " --no-plots");
   EXPECT_EQ(r.exit_code, 1) << r.output;  // nothing calibrated (docs/calibration.md)
   EXPECT_THAT(r.output, HasSubstr("the motion was too poor to calibrate"));
   EXPECT_THAT(r.output, Not(HasSubstr("disagree beyond noise")));
