@@ -7,7 +7,9 @@
 #       SCENARIOS="handheld-loop harvester dense_spruce", REALISM="ideal typical harsh",
 #       SEEDS="1 2 3 4 5", DURATION_harvester=..., DURATION_<scenario>=... (default: the
 #       scenario's own), BEAMS=64 to simulate fewer lidar rows (default: the full 128),
-#       KEEP=1 to keep the recordings)
+#       KEEP=1 to keep the recordings, OVERRIDES=file.yaml passed to every `taiga simulate`
+#       (a recording kind, docs/simulator.md) with TAG=name, which the csv's scenario column
+#       then carries as scenario[name])
 #
 # One row per run is appended to WORK_DIR/robustness.csv as soon as it is done; cells already in
 # it are skipped, so an interrupted table resumes. bench/robustness.py turns it into Markdown and
@@ -34,6 +36,8 @@ except Exception:
 
 beam_args=()
 [[ -n ${BEAMS:-} ]] && beam_args=(--beams "$BEAMS")
+[[ -n ${OVERRIDES:-} ]] && beam_args+=(--overrides "$OVERRIDES")
+tag=${TAG:+[$TAG]}
 
 for scenario in ${SCENARIOS:-handheld-loop harvester dense_spruce}; do
   var=DURATION_${scenario//-/_}
@@ -41,15 +45,15 @@ for scenario in ${SCENARIOS:-handheld-loop harvester dense_spruce}; do
   [[ -n ${!var:-} ]] && duration_args=(--duration "${!var}")
   for realism in ${REALISM:-ideal typical harsh}; do
     for seed in ${SEEDS:-1 2 3 4 5}; do
-      if grep -q "^$scenario,$realism,$seed," "$csv"; then continue; fi
-      sim=$work/sim_${scenario}_${realism}_$seed
-      run=$work/run_${scenario}_${realism}_$seed
+      if cut -d, -f1-3 "$csv" | grep -qxF "$scenario$tag,$realism,$seed"; then continue; fi
+      sim=$work/sim_${scenario}${TAG:+_$TAG}_${realism}_$seed
+      run=$work/run_${scenario}${TAG:+_$TAG}_${realism}_$seed
       rm -rf "$sim" "$run"
       "$taiga" simulate --scenario "$scenario" --realism "$realism" --seed "$seed" \
-        "${duration_args[@]}" "${beam_args[@]}" --out "$sim" > "$work/sim_${scenario}_${realism}_$seed.log" 2>&1
+        "${duration_args[@]}" "${beam_args[@]}" --out "$sim" > "$sim.log" 2>&1
       code=0
       "$taiga" run "$sim/recording.bag" --config "$sim/rig.yaml" --out "$run" \
-        > "$work/run_${scenario}_${realism}_$seed.log" 2>&1 || code=$?
+        > "$run.log" 2>&1 || code=$?
       read -r ate ate_max drift drift_pct path < <(evaluate "$run/trajectory.tum" "$sim/groundtruth.tum")
       read -r ate_odom _ < <(evaluate "$run/trajectory_odometry.tum" "$sim/groundtruth.tum")
       summary=$(python3 -c '
@@ -62,7 +66,7 @@ try:
 except Exception:
     print("nan nan nan nan nan nan nan nan")' "$run/summary.json")
       read -r scans rejected loops rtf dur health degraded lost <<< "$summary"
-      echo "$scenario,$realism,$seed,$dur,$code,$scans,$rejected,$loops,$ate,$ate_odom,$ate_max,$drift,$drift_pct,$path,$rtf,$health,$degraded,$lost" >> "$csv"
+      echo "$scenario$tag,$realism,$seed,$dur,$code,$scans,$rejected,$loops,$ate,$ate_odom,$ate_max,$drift,$drift_pct,$path,$rtf,$health,$degraded,$lost" >> "$csv"
       tail -1 "$csv"
       [[ ${KEEP:-0} == 1 ]] || rm -rf "$sim/recording.bag" "$run/keyframes" "$run/map.las"
     done

@@ -26,8 +26,8 @@ Unpacked unpack(const double* pose, const double* motion) {
 
 }  // namespace
 
-ImuFactor::ImuFactor(imu::Preintegrator preintegrated, const Eigen::Vector3d& gravity_world)
-    : preintegrated_(std::move(preintegrated)), gravity_world_(gravity_world) {
+ImuFactor::ImuFactor(imu::Preintegrator preintegrated, const Eigen::Vector3d& gravity_nominal)
+    : preintegrated_(std::move(preintegrated)), gravity_nominal_(gravity_nominal) {
   const double dt = preintegrated_.deltaTime();
   const imu::ImuNoise& noise = preintegrated_.noise();
   covariance_.setZero();
@@ -41,7 +41,7 @@ ImuFactor::ImuFactor(imu::Preintegrator preintegrated, const Eigen::Vector3d& gr
 
 Vector15 ImuFactor::rawResidual(const StateBlocks& i, const StateBlocks& j) const {
   Vector15 r;
-  r.head<9>() = preintegrated_.residual(i.navState(), j.navState(), i.bias(), gravity_world_);
+  r.head<9>() = preintegrated_.residual(i.navState(), j.navState(), i.bias(), gravity_nominal_);
   r.segment<3>(9) = j.bias().accel_mps2 - i.bias().accel_mps2;
   r.segment<3>(12) = j.bias().gyro_radps - i.bias().gyro_radps;
   return r;
@@ -53,9 +53,12 @@ bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
   const Unpacked j = unpack(parameters[2], parameters[3]);
   const double dt = preintegrated_.deltaTime();
   const imu::ImuBias& bias_hat = preintegrated_.biasHat();
+  Eigen::Matrix<double, 3, kTiltSize> dg_dtilt;
+  const Vector3 gravity_world =
+      gravityFromTilt(parameters[4], gravity_nominal_, jacobians ? &dg_dtilt : nullptr);
 
   Vector15 r;
-  r.head<9>() = preintegrated_.residual(i.state, j.state, i.bias, gravity_world_);
+  r.head<9>() = preintegrated_.residual(i.state, j.state, i.bias, gravity_world);
   r.segment<3>(9) = j.bias.accel_mps2 - i.bias.accel_mps2;
   r.segment<3>(12) = j.bias.gyro_radps - i.bias.gyro_radps;
   Eigen::Map<Vector15>{residuals} = sqrt_information_ * r;
@@ -65,9 +68,9 @@ bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
   const Matrix3 R_i_T = i.state.R_world_body.inverse().matrix();
   const Vector3 r_R = r.head<3>();
   const Matrix3 Jr_inv = lie::SO3::rightJacobianInverse(r_R);
-  const Vector3 dv_world = j.state.v_world - i.state.v_world - gravity_world_ * dt;
+  const Vector3 dv_world = j.state.v_world - i.state.v_world - gravity_world * dt;
   const Vector3 dp_world =
-      j.state.p_world - i.state.p_world - i.state.v_world * dt - 0.5 * gravity_world_ * dt * dt;
+      j.state.p_world - i.state.p_world - i.state.v_world * dt - 0.5 * gravity_world * dt * dt;
   const Vector3 dbg = i.bias.gyro_radps - bias_hat.gyro_radps;
   const Matrix3 dR_dbg_corrected = -Jr_inv * lie::SO3::Exp(r_R).inverse().matrix() *
                                    lie::SO3::rightJacobian(preintegrated_.dR_dbg() * dbg) *
@@ -107,6 +110,14 @@ bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
     J.block<3, 3>(9, 3) = Matrix3::Identity();
     J.block<3, 3>(12, 6) = Matrix3::Identity();
     Eigen::Map<RowMajorJacobian15x9>{jacobians[3]} = sqrt_information_ * J;
+  }
+  if (jacobians[4]) {  // tilt: r_v and r_p move with -R_i^T g dt and -R_i^T g dt^2 / 2
+    Eigen::Matrix<double, 15, kTiltSize, Eigen::RowMajor> J =
+        Eigen::Matrix<double, 15, kTiltSize, Eigen::RowMajor>::Zero();
+    J.block<3, kTiltSize>(3, 0) = -R_i_T * dg_dtilt * dt;
+    J.block<3, kTiltSize>(6, 0) = -0.5 * R_i_T * dg_dtilt * dt * dt;
+    Eigen::Map<Eigen::Matrix<double, 15, kTiltSize, Eigen::RowMajor>>{jacobians[4]} =
+        sqrt_information_ * J;
   }
   return true;
 }

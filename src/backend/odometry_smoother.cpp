@@ -73,6 +73,16 @@ Matrix15 weakCovariance() {
   return sigma.cwiseAbs2().asDiagonal();
 }
 
+/// A state's covariance and the tilt's, independent; a tilt that is not estimated is held
+/// constant and its (unit) variance never enters.
+StatePrior::Covariance withTilt(const Matrix15& state, double tilt_sigma_rad) {
+  const double variance = tilt_sigma_rad > 0.0 ? tilt_sigma_rad * tilt_sigma_rad : 1.0;
+  StatePrior::Covariance covariance = StatePrior::Covariance::Zero();
+  covariance.topLeftCorner<15, 15>() = state;
+  covariance.bottomRightCorner<kTiltSize, kTiltSize>().diagonal().setConstant(variance);
+  return covariance;
+}
+
 /// x (+) delta in the tangent order [dp; dtheta; dv; dba; dbg].
 StateBlocks plus(const StateBlocks& x, const Eigen::Matrix<double, 15, 1>& delta) {
   StateBlocks moved = x;
@@ -90,12 +100,15 @@ OdometrySmoother::OdometrySmoother(OdometrySmootherOptions options) : options_(o
 
 OdometrySmoother::~OdometrySmoother() = default;
 
-void OdometrySmoother::initialize(const StateEstimate& first) {
+void OdometrySmoother::initialize(const StateEstimate& first, double tilt_sigma_rad) {
   window_.clear();
   auto node = std::make_unique<Node>();
   node->t_s = first.t_s;
   node->blocks = StateBlocks::from(first.state, first.bias);
-  node->prior = std::make_unique<StatePrior>(node->blocks, first.covariance);
+  tilt_ = {0.0, 0.0};
+  tilt_sigma_rad_ = tilt_sigma_rad;
+  node->prior = std::make_unique<StatePrior>(node->blocks, StatePrior::Tilt::Zero(),
+                                             withTilt(first.covariance, tilt_sigma_rad_));
   window_.push_back(std::move(node));
   latest_ = first;
 }
@@ -109,7 +122,7 @@ StateEstimate OdometrySmoother::addState(double t_s, const imu::Preintegrator& p
   // Initial guess: the IMU prediction from the newest state.
   const imu::ImuBias bias = newest.blocks.bias();
   node->blocks = StateBlocks::from(
-      preintegrated.predict(newest.blocks.navState(), bias, options_.gravity_world), bias);
+      preintegrated.predict(newest.blocks.navState(), bias, gravityWorld()), bias);
   node->imu_from_previous = std::make_unique<ImuFactor>(preintegrated, options_.gravity_world);
   if (measurement)
     node->pose = std::make_unique<PoseFactor>(measurement->T_world_body, measurement->covariance);
@@ -119,9 +132,24 @@ StateEstimate OdometrySmoother::addState(double t_s, const imu::Preintegrator& p
   return latest_;
 }
 
+Eigen::Vector3d OdometrySmoother::gravityWorld() const {
+  return gravityFromTilt(tilt_.data(), options_.gravity_world);
+}
+
+void OdometrySmoother::addTilt(ceres::Problem& problem, std::vector<double*>& linearized) {
+  problem.AddParameterBlock(tilt_.data(), kTiltSize);
+  if (estimatesTilt()) {
+    linearized.push_back(tilt_.data());
+  } else {
+    problem.SetParameterBlockConstant(tilt_.data());
+  }
+}
+
 void OdometrySmoother::optimize() {
   ceres::Problem problem(borrowingOptions());
+  // The tilt first, so that the newest state is the last 15 columns.
   std::vector<double*> blocks;
+  addTilt(problem, blocks);
   for (std::size_t k = 0; k < window_.size(); ++k) {
     Node& node = *window_[k];
     addNode(problem, node.blocks);
@@ -129,13 +157,13 @@ void OdometrySmoother::optimize() {
     blocks.push_back(node.blocks.motion.data());
     if (node.prior)
       problem.AddResidualBlock(node.prior.get(), nullptr, node.blocks.pose.data(),
-                               node.blocks.motion.data());
+                               node.blocks.motion.data(), tilt_.data());
     if (node.pose) problem.AddResidualBlock(node.pose.get(), nullptr, node.blocks.pose.data());
     if (k > 0 && node.imu_from_previous) {
       Node& previous = *window_[k - 1];
       problem.AddResidualBlock(node.imu_from_previous.get(), nullptr, previous.blocks.pose.data(),
                                previous.blocks.motion.data(), node.blocks.pose.data(),
-                               node.blocks.motion.data());
+                               node.blocks.motion.data(), tilt_.data());
     }
   }
   ceres::Solver::Options solver_options;
@@ -154,7 +182,8 @@ void OdometrySmoother::optimize() {
   latest_.state = newest.blocks.navState();
   latest_.bias = newest.blocks.bias();
   const Eigen::Index n = H.rows();
-  if (n < 15 || !H.allFinite()) {  // not evaluable: the covariance is unknown, not garbage
+  if (n < 15 + (estimatesTilt() ? kTiltSize : 0) ||
+      !H.allFinite()) {  // not evaluable: the covariance is unknown, not garbage
     logger().warn(
         "odometry smoother: the window's factors were not finite at {:.3f} s; its "
         "covariance is reported as a weak prior's",
@@ -174,48 +203,67 @@ void OdometrySmoother::marginalizeOldest() {
   ceres::Problem problem(borrowingOptions());
   addNode(problem, oldest.blocks);
   addNode(problem, next.blocks);
+  std::vector<double*> blocks{oldest.blocks.pose.data(), oldest.blocks.motion.data(),
+                              next.blocks.pose.data(), next.blocks.motion.data()};
+  addTilt(problem, blocks);
   if (oldest.prior)
     problem.AddResidualBlock(oldest.prior.get(), nullptr, oldest.blocks.pose.data(),
-                             oldest.blocks.motion.data());
+                             oldest.blocks.motion.data(), tilt_.data());
   if (oldest.pose) problem.AddResidualBlock(oldest.pose.get(), nullptr, oldest.blocks.pose.data());
   problem.AddResidualBlock(next.imu_from_previous.get(), nullptr, oldest.blocks.pose.data(),
                            oldest.blocks.motion.data(), next.blocks.pose.data(),
-                           next.blocks.motion.data());
+                           next.blocks.motion.data(), tilt_.data());
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
-  linearize(problem,
-            {oldest.blocks.pose.data(), oldest.blocks.motion.data(), next.blocks.pose.data(),
-             next.blocks.motion.data()},
-            H, b);
-  // Schur complement onto the next state: H' = H11 - H10 H00^-1 H01, b' = b1 - H10 H00^-1 b0.
-  const Eigen::LDLT<Eigen::MatrixXd> H00(H.topLeftCorner(15, 15));
-  Matrix15 H_marginal = H.bottomRightCorner(15, 15) -
-                        H.bottomLeftCorner(15, 15) * H00.solve(H.topRightCorner(15, 15));
-  const Eigen::Matrix<double, 15, 1> b_marginal =
-      b.tail(15) - H.bottomLeftCorner(15, 15) * H00.solve(b.head(15));
-  if (H.rows() != 30 || !H_marginal.allFinite() || !b_marginal.allFinite()) {
+  linearize(problem, blocks, H, b);
+  // Schur complement onto the next state and the tilt (when estimated): H' = H11 - H10 H00^-1
+  // H01, b' = b1 - H10 H00^-1 b0.
+  const Eigen::Index m = 15 + (estimatesTilt() ? kTiltSize : 0);
+  const bool evaluated = H.rows() == 15 + m;
+  Eigen::MatrixXd H_marginal;
+  Eigen::VectorXd b_marginal;
+  if (evaluated) {
+    const Eigen::LDLT<Eigen::MatrixXd> H00(H.topLeftCorner(15, 15));
+    H_marginal =
+        H.bottomRightCorner(m, m) - H.bottomLeftCorner(m, 15) * H00.solve(H.topRightCorner(15, m));
+    b_marginal = b.tail(m) - H.bottomLeftCorner(m, 15) * H00.solve(b.head(15));
+  }
+  if (!evaluated || !H_marginal.allFinite() || !b_marginal.allFinite()) {
     // The factors could not be evaluated (a non-finite IMU factor, e.g. across a long gap in
     // the readings): the next state keeps a weak prior at its estimate instead of a broken one.
     logger().warn(
         "odometry smoother: the marginalized state's factors were not finite at {:.3f} "
         "s; the window keeps a weak prior instead",
         next.t_s);
-    next.prior = std::make_unique<StatePrior>(next.blocks, weakCovariance());
+    next.prior =
+        std::make_unique<StatePrior>(next.blocks, Eigen::Map<const StatePrior::Tilt>(tilt_.data()),
+                                     withTilt(weakCovariance(), tilt_sigma_rad_));
   } else {
     // The quadratic 1/2 d^T H' d + b'^T d is a Gaussian with mean next (+) (-H'^-1 b'). H' is
     // made symmetric and its eigenvalues floored at 1e-12 of the largest: when a direction lost
     // nearly all its information (a gap in the IMU readings, no lidar), the covariance would
     // otherwise span more than double precision and its inverse in StatePrior fail.
     H_marginal = 0.5 * (H_marginal + H_marginal.transpose());
-    const Eigen::SelfAdjointEigenSolver<Matrix15> eigen(H_marginal);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(H_marginal);
     const double floor = 1e-12 * std::max(eigen.eigenvalues().maxCoeff(), 1e-300);
-    const Eigen::Matrix<double, 15, 1> lambda = eigen.eigenvalues().cwiseMax(floor);
-    const Matrix15& V = eigen.eigenvectors();
-    const Eigen::Matrix<double, 15, 1> shift =
+    const Eigen::VectorXd lambda = eigen.eigenvalues().cwiseMax(floor);
+    const Eigen::MatrixXd& V = eigen.eigenvectors();
+    const Eigen::VectorXd shift =
         -V * lambda.cwiseInverse().asDiagonal() * V.transpose() * b_marginal;
-    Matrix15 covariance = V * lambda.cwiseInverse().asDiagonal() * V.transpose();
+    Eigen::MatrixXd covariance = V * lambda.cwiseInverse().asDiagonal() * V.transpose();
     covariance = 0.5 * (covariance + covariance.transpose());
-    next.prior = std::make_unique<StatePrior>(plus(next.blocks, shift), covariance);
+    // The prior's tilt is the estimate moved by its share of the shift; not estimated, it stays
+    // constant and its variance is a placeholder.
+    StatePrior::Tilt tilt_mean = Eigen::Map<const StatePrior::Tilt>(tilt_.data());
+    StatePrior::Covariance prior_covariance;
+    if (estimatesTilt()) {
+      tilt_mean += shift.tail<kTiltSize>();
+      prior_covariance = covariance;
+    } else {
+      prior_covariance = withTilt(covariance, 0.0);
+    }
+    next.prior = std::make_unique<StatePrior>(plus(next.blocks, shift.head<15>()), tilt_mean,
+                                              prior_covariance);
   }
   next.imu_from_previous.reset();
   window_.pop_front();

@@ -41,6 +41,19 @@ imu::ImuBias StateBlocks::bias() const {
 
 lie::SE3 StateBlocks::T_world_body() const { return poseFromBlock(pose.data()); }
 
+Eigen::Vector3d gravityFromTilt(const double* tilt, const Eigen::Vector3d& g_nominal,
+                                Eigen::Matrix<double, 3, kTiltSize>* d_gravity_d_tilt) {
+  // Exactly g_nominal at a zero tilt, so an odometry that does not estimate the tilt is unchanged.
+  if (tilt[0] == 0.0 && tilt[1] == 0.0 && !d_gravity_d_tilt) return g_nominal;
+  const Eigen::Vector3d phi(tilt[0], tilt[1], 0.0);
+  const lie::SO3 R = lie::SO3::Exp(phi);
+  if (d_gravity_d_tilt) {
+    const Eigen::Matrix3d J = -(R.matrix() * lie::hat(g_nominal) * lie::SO3::rightJacobian(phi));
+    *d_gravity_d_tilt = J.leftCols<kTiltSize>();
+  }
+  return R * g_nominal;
+}
+
 lie::SE3 poseFromBlock(const double* pose_block) {
   return lie::SE3(rotationOf(pose_block), Eigen::Map<const Eigen::Vector3d>(pose_block));
 }

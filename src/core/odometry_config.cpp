@@ -128,6 +128,8 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.field("gravity_alignment_s", gravity_alignment_s,
           "s, span of the first scans used to level the world frame with lidar and IMU (0: IMU "
           "attitude only)");
+  v.field("gravity_tilt_sigma_deg", gravity_tilt_sigma_deg,
+          "deg, prior 1-sigma of the levelled frame's tilt, estimated on (0: held as levelled)");
   v.section("imu", imu, "IMU noise model");
   v.section("health", health,
             "when a scan is degraded or the track lost (docs/odometry.md, Health)");
@@ -174,6 +176,7 @@ void OdometryConfig::validate() const {
                      "m/rad");
   requireInRange("window_states", window_states, 2, 50, "states");
   requireInRange("gravity_alignment_s", gravity_alignment_s, 0.0, 30.0, "s");
+  requireInRange("gravity_tilt_sigma_deg", gravity_tilt_sigma_deg, 0.0, 10.0, "deg");
 }
 
 }  // namespace taiga

@@ -40,7 +40,8 @@ void Mapper::addGnssFix(const GnssFix& fix) {
   if (gnss_) gnss_->addFix(fix);
 }
 
-void Mapper::finish() {
+void Mapper::finish(const lie::SO3& R_level_map) {
+  graph_.rotateMap(R_level_map);
   if (gnss_ && gnss_->finish(graph_)) graph_.optimize();
 }
 
@@ -179,10 +180,11 @@ bool Mapper::acceptWithAgreeingLoop(LoopRecord& record) {
       "accepted with the loop at keyframe {}, which agrees with it (pair chi2 {:.1f}); chi2 "
       "{:.1f} against the graph",
       earlier.attempt.loop.to, best_chi2, record.chi2);
-  logger().info("loops at keyframes {} and {} agree (pair chi2 {:.1f}) though the graph "
-                "disputed them (chi2 {:.1f} and {:.1f}): both kept, the odometry drifted more than "
-                "mapping.odometry_sigma_* allow",
-                earlier.attempt.loop.to, loop.to, best_chi2, earlier.chi2, record.chi2);
+  logger().info(
+      "loops at keyframes {} and {} agree (pair chi2 {:.1f}) though the graph "
+      "disputed them (chi2 {:.1f} and {:.1f}): both kept, the odometry drifted more than "
+      "mapping.odometry_sigma_* allow",
+      earlier.attempt.loop.to, loop.to, best_chi2, earlier.chi2, record.chi2);
   return true;
 }
 
@@ -270,7 +272,7 @@ std::optional<GraphSnapshot> MappingThread::waitForSnapshot(std::size_t keyframe
   return snapshot;
 }
 
-Mapper& MappingThread::finish() {
+Mapper& MappingThread::finish(const lie::SO3& R_level_map) {
   {
     const std::lock_guard lock(mutex_);
     stopping_ = true;
@@ -280,7 +282,7 @@ Mapper& MappingThread::finish() {
   if (error_) std::rethrow_exception(error_);
   if (!finished_) {
     finished_ = true;
-    mapper_.finish();
+    mapper_.finish(R_level_map);
   }
   return mapper_;
 }

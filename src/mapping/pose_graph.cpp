@@ -122,6 +122,16 @@ void PoseGraph::addPosition(std::size_t keyframe, const Eigen::Vector3d& p_map,
   positions_.push_back({keyframe, p_map, covariance, huber_sigmas});
 }
 
+void PoseGraph::rotateMap(const lie::SO3& R_new_old) {
+  const lie::SE3 T_new_old(R_new_old, Eigen::Vector3d::Zero());
+  for (lie::SE3& pose : poses_) pose = T_new_old * pose;
+  for (Position& position : positions_) {
+    position.p_map = R_new_old * position.p_map;
+    position.covariance = R_new_old.matrix() * position.covariance * R_new_old.matrix().transpose();
+  }
+  if (T_enu_map_) setEnuMap(*T_enu_map_ * T_new_old.inverse());
+}
+
 double PoseGraph::optimize() {
   if (size() < 2) return 0.0;
   std::vector<PoseBlock> blocks;

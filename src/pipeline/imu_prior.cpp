@@ -100,12 +100,12 @@ MotionPrediction ImuPrior::predict(const io::Scan& scan) {
     return prediction;
   }
   prediction.T_odom_body =
-      poseOf(preintegrated_->predict(previous.state, previous.bias, gravity_odom_));
+      poseOf(preintegrated_->predict(previous.state, previous.bias, smoother_.gravityWorld()));
   // Propagation at IMU rate over the sweep (from its start when it began before the state).
   const double t_from_s = std::min(previous.t_s, scan.t_start_s);
-  const auto states =
-      imu::propagateThrough(previous.state, previous.t_s, scan.t_end_s,
-                            imu_.signalOver(t_from_s, scan.t_end_s), previous.bias, gravity_odom_);
+  const auto states = imu::propagateThrough(previous.state, previous.t_s, scan.t_end_s,
+                                            imu_.signalOver(t_from_s, scan.t_end_s), previous.bias,
+                                            smoother_.gravityWorld());
   for (std::size_t k = 1; k < states.size(); ++k)
     prediction.imu_rate_poses.push_back({states[k].t_s, poseOf(states[k].state)});
   prediction.sweep_T_odom_body = imu::toTrajectory(states);

@@ -41,6 +41,11 @@ class ImuPrior final : public MotionPrior {
   MotionUpdate update(const std::optional<backend::PoseMeasurement>& lidar) override;
   bool levelled() const override { return levelled_; }
   const std::string& initializationNote() const override { return initialization_note_; }
+  /// Exp(-[theta; 0]): turns the estimated gravity back to -z (backend/state_blocks.hpp).
+  lie::SO3 R_level_odom() const override {
+    const Eigen::Vector2d tilt = smoother_.tilt();
+    return lie::SO3::Exp(Eigen::Vector3d(-tilt.x(), -tilt.y(), 0.0));
+  }
 
  private:
   /// Attitude and biases from the IMU readings, and the time the state starts at.

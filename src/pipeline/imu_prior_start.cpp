@@ -101,7 +101,9 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
                                             kUnlevelledAccelBiasSigma_mps2 *
                                             kUnlevelledAccelBiasSigma_mps2;
   }
-  smoother_.initialize(estimate);
+  // A frame levelled by the IMU's attitude alone keeps estimating its tilt from the start; an
+  // unlevelled one lets the loose bias absorb its gravity error until the levelling.
+  smoother_.initialize(estimate, levelled_ ? config_.gravity_tilt_sigma_deg * kRadPerDeg : 0.0);
 
   FirstScan out{.index = first.index,
                 .t_s = first.t_end_s,
@@ -165,7 +167,7 @@ std::optional<lie::SE3> ImuPrior::levelFrame() {
   levelled.covariance.block<15, 3>(0, 9).setZero();
   levelled.covariance.block<3, 3>(9, 9) =
       Eigen::Matrix3d::Identity() * imu::kStartAccelBiasSigma_mps2 * imu::kStartAccelBiasSigma_mps2;
-  smoother_.initialize(levelled);
+  smoother_.initialize(levelled, config_.gravity_tilt_sigma_deg * kRadPerDeg);
   const double tilt_deg =
       std::acos(std::clamp(a.gravity_world.normalized().z() * -1.0, -1.0, 1.0)) / kRadPerDeg;
   logger().info(

@@ -114,6 +114,9 @@ class MotionPrior {
   /// True once the odom frame is final: levelled, or with no levelling to wait for.
   virtual bool levelled() const = 0;
   virtual const std::string& initializationNote() const = 0;
+  /// The rotation that levels the odom frame by the model's estimate of its tilt (identity
+  /// when it has none).
+  virtual lie::SO3 R_level_odom() const { return {}; }
 };
 
 /// The IMU model, or constant velocity when `lidar_only`. `preparation` and `registration`

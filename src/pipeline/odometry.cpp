@@ -106,6 +106,8 @@ bool Odometry::odomFrameFinal() const { return motion_->levelled(); }
 
 const std::string& Odometry::initializationNote() const { return motion_->initializationNote(); }
 
+lie::SO3 Odometry::R_level_odom() const { return motion_->R_level_odom(); }
+
 std::vector<ScanOutcome> Odometry::addScan(const io::Scan& scan) {
   std::vector<ScanOutcome> outcomes;
   std::optional<FirstScan> first;

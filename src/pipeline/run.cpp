@@ -296,6 +296,12 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);
+  summary.frame_tilt_deg = -slam.odometry().R_level_odom().Log().head<2>() / kRadPerDeg;
+  if (!summary.frame_tilt_deg.isZero())
+    logger().info(
+        "the odom frame was {:.2f} deg off level by the odometry's final estimate; the "
+        "trajectories and the map are levelled by it",
+        summary.frame_tilt_deg.norm());
   scan_log.fillSummary(summary);
   summary.health = health.finish();
   std::vector<Reattachment>& reattached = summary.health.reattached;
@@ -317,7 +323,8 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     summary.trees_work_s = online_trees->workSeconds();
     summary.trees_updates = online_trees->updates();
   }
-  const Trajectory corrected = trajectories.write(out, mapper.graph());
+  const Trajectory corrected =
+      trajectories.write(out, mapper.graph(), slam.odometry().R_level_odom());
   writeLoops(out / "loops.csv", mapper.loopAttempts());
   io::writeTum(out / "keyframes.tum", slam.keyframes().trajectory());
   const auto export_start = Clock::now();

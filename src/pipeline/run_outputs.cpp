@@ -41,8 +41,13 @@ void TrajectoryRecorder::onKeyframe(std::uint64_t /*id*/, const ScanOutcome& sca
 }
 
 Trajectory TrajectoryRecorder::write(const std::filesystem::path& dir,
-                                     const mapping::PoseGraph& graph) const {
-  io::writeTum(dir / "trajectory_odometry.tum", odometry_);
+                                     const mapping::PoseGraph& graph,
+                                     const lie::SO3& R_level_odom) const {
+  const lie::SE3 T_level_odom(R_level_odom, Eigen::Vector3d::Zero());
+  Trajectory levelled;
+  for (const StampedPose& pose : odometry_.poses())
+    levelled.append(pose.t_s, T_level_odom * pose.pose);
+  io::writeTum(dir / "trajectory_odometry.tum", levelled);
   io::writeTum(dir / "trajectory_online.tum", online_);
   Trajectory corrected = mapping::correctedTrajectory(odometry_, graph, keyframe_times_s_);
   io::writeTum(dir / "trajectory.tum", corrected);

@@ -25,9 +25,11 @@ class TrajectoryRecorder final : public SlamObserver {
   void onKeyframe(std::uint64_t id, const ScanOutcome& scan) override;
 
   const Trajectory& odometry() const { return odometry_; }
-  /// trajectory_odometry.tum, trajectory_online.tum, trajectory.tum and trajectory_imu.tum
-  /// (these two corrected by `graph`) into `dir`; returns trajectory.tum's T_map_body.
-  Trajectory write(const std::filesystem::path& dir, const mapping::PoseGraph& graph) const;
+  /// trajectory_odometry.tum (turned by R_level_odom, the odometry's final levelling),
+  /// trajectory_online.tum (as published), trajectory.tum and trajectory_imu.tum (corrected by
+  /// `graph`) into `dir`; returns trajectory.tum's T_map_body.
+  Trajectory write(const std::filesystem::path& dir, const mapping::PoseGraph& graph,
+                   const lie::SO3& R_level_odom) const;
 
  private:
   Trajectory odometry_, imu_rate_, online_;

@@ -137,6 +137,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"realtime_factor", s.realtime_factor},
       {"peak_memory_mb", s.peak_memory_mb},
       {"initialization", s.initialization},
+      {"frame_tilt_deg", {s.frame_tilt_deg.x(), s.frame_tilt_deg.y()}},
       {"health", healthJson(s.health)},
   };
   if (s.trees)

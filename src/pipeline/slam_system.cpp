@@ -137,7 +137,7 @@ const mapping::Mapper& SlamSystem::finish() {
     releaseHeld(std::nullopt);  // a run too short to level: its frame is the unlevelled one
     finished_ = true;
   }
-  const mapping::Mapper& mapper = mapping_thread_.finish();
+  const mapping::Mapper& mapper = mapping_thread_.finish(odometry_.R_level_odom());
   store_.setPoses(mapper.graph().poses());
   store_.writePoses();
   return mapper;

@@ -90,10 +90,15 @@ TEST(FactorJacobians, ImuFactorMatchesNumericalDifferentiation) {
   for (int k = 0; k < 50; ++k)
     pre.integrate(WavyMotion::accel(k * 0.005), WavyMotion::gyro(k * 0.005), 0.005);
   const ImuFactor factor(pre, kGravityWorld);
+  std::normal_distribution<double> tilt_rad(0.0, 0.05);
   for (int trial = 0; trial < 5; ++trial) {
     const StateBlocks i = randomState(rng), j = randomState(rng);
-    EXPECT_LT(worstJacobianError(factor, {vec(i.pose), vec(i.motion), vec(j.pose), vec(j.motion)}),
-              1e-5);
+    // The frame's tilt: zero (the odometry without the estimate) and a few degrees.
+    const std::vector<double> tilt = trial == 0 ? std::vector<double>{0.0, 0.0}
+                                                : std::vector<double>{tilt_rad(rng), tilt_rad(rng)};
+    EXPECT_LT(
+        worstJacobianError(factor, {vec(i.pose), vec(i.motion), vec(j.pose), vec(j.motion), tilt}),
+        1e-5);
   }
 }
 
@@ -170,12 +175,13 @@ TEST(FactorJacobians, GnssFactorResidualIsTheWhitenedEnuDifference) {
 
 TEST(FactorJacobians, StatePriorMatchesNumericalDifferentiation) {
   std::mt19937_64 rng(7);
-  Matrix15 covariance = Matrix15::Identity() * 0.04;
+  StatePrior::Covariance covariance = StatePrior::Covariance::Identity() * 0.04;
   covariance(2, 7) = covariance(7, 2) = 0.01;
+  covariance(10, 16) = covariance(16, 10) = 0.005;  // accelerometer bias and the frame's tilt
   for (int trial = 0; trial < 5; ++trial) {
-    const StatePrior factor(randomState(rng), covariance);
+    const StatePrior factor(randomState(rng), {0.01, -0.02}, covariance);
     const StateBlocks x = randomState(rng);
-    EXPECT_LT(worstJacobianError(factor, {vec(x.pose), vec(x.motion)}), 1e-6);
+    EXPECT_LT(worstJacobianError(factor, {vec(x.pose), vec(x.motion), {0.03, 0.01}}), 1e-6);
   }
 }
 

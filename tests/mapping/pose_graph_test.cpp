@@ -132,5 +132,27 @@ TEST(PoseGraph, TwoLoopsAgreeOverTheShortOdometryBetweenTheirEnds) {
   EXPECT_TRUE(std::isinf(segmented.loopPairChi2(first, second)));
 }
 
+TEST(PoseGraph, RotatingTheMapTurnsEveryPoseAndKeepsTheFactorsSatisfied) {
+  // The odometry's frame 1.5 deg off level: the graph is levelled at the end by turning the
+  // whole map (the odometry's final tilt estimate), which changes no relative factor.
+  const std::vector<lie::SE3> truth = trueSquareLoop();
+  PoseGraph graph = graphOf(driftingOdometry(truth));
+  graph.addLoop(loopFromTruth(truth, 0, 159));
+  const double cost = graph.optimize();
+  const std::vector<lie::SE3> before = graph.poses();
+  const lie::SO3 R_level = lie::SO3::Exp(Eigen::Vector3d(0.02, -0.015, 0.0));
+  graph.setEnuMap(lie::SE3(lie::SO3::Exp(Eigen::Vector3d(0, 0, 0.5)), Eigen::Vector3d(3, 4, 5)));
+  graph.rotateMap(R_level);
+  for (std::size_t k = 0; k < before.size(); ++k) {
+    EXPECT_LT((graph.pose(k).translation() - R_level * before[k].translation()).norm(), 1e-9);
+    EXPECT_LT((graph.pose(k).rotation().inverse() * R_level * before[k].rotation()).angle(), 1e-9);
+  }
+  // Relative factors only: the optimum is where it was (the cost of the turned poses).
+  EXPECT_NEAR(graph.optimize(), cost, 1e-9 * std::max(1.0, cost));
+  // T_enu_map keeps its yaw and translation, with the map's new tilt dropped.
+  ASSERT_TRUE(graph.enuMap());
+  EXPECT_LT(std::abs(graph.enuMap()->rotation().matrix()(2, 2) - 1.0), 1e-12);
+}
+
 }  // namespace
 }  // namespace taiga::mapping

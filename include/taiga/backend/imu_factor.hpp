@@ -10,7 +10,11 @@
 // Covariance: the preintegration's noise covariance for [r_R; r_v; r_p] and the random walk's
 // sigma^2 dt for the biases.
 //
-// Parameter blocks: pose_i (7), motion_i (9), pose_j (7), motion_j (9); see state_blocks.hpp.
+// with g the odom frame's gravity: g_nominal turned by the tilt block (state_blocks.hpp,
+// gravityFromTilt), held constant unless the odometry estimates the frame's tilt.
+//
+// Parameter blocks: pose_i (7), motion_i (9), pose_j (7), motion_j (9), tilt (2); see
+// state_blocks.hpp.
 
 #include <ceres/sized_cost_function.h>
 
@@ -24,21 +28,21 @@ namespace taiga::backend {
 using Vector15 = Eigen::Matrix<double, 15, 1>;
 using Matrix15 = Eigen::Matrix<double, 15, 15>;
 
-class ImuFactor final
-    : public ceres::SizedCostFunction<15, kPoseSize, kMotionSize, kPoseSize, kMotionSize> {
+class ImuFactor final : public ceres::SizedCostFunction<15, kPoseSize, kMotionSize, kPoseSize,
+                                                        kMotionSize, kTiltSize> {
  public:
-  ImuFactor(imu::Preintegrator preintegrated, const Eigen::Vector3d& gravity_world);
+  ImuFactor(imu::Preintegrator preintegrated, const Eigen::Vector3d& gravity_nominal);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
-  /// The unwhitened residual, for tests and diagnostics.
+  /// The unwhitened residual at a zero tilt, for tests and diagnostics.
   Vector15 rawResidual(const StateBlocks& i, const StateBlocks& j) const;
   const Matrix15& covariance() const { return covariance_; }
 
  private:
   imu::Preintegrator preintegrated_;
-  Eigen::Vector3d gravity_world_;
+  Eigen::Vector3d gravity_nominal_;
   Matrix15 covariance_;
   Matrix15 sqrt_information_;  ///< L^T with L L^T = covariance^-1
 };

@@ -9,10 +9,21 @@
 // complement), so the cost per scan stays bounded and no information is thrown away beyond the
 // linearization. A lag of 1 is an iterated extended Kalman filter; longer lags re-linearize the
 // IMU factors of recent states when a late lidar factor moves them.
+//
+// The odom frame's tilt against gravity (state_blocks.hpp, kTiltSize) can be a further unknown
+// shared by every IMU factor (initialize() with a tilt sigma; after FAST-LIO2, which keeps
+// gravity in its state): the frame was levelled from 2 s of data, where a horizontal accelerometer
+// bias and a tilt look alike, and once the rig turns the IMU tells them apart. With the tilt fixed,
+// that late evidence could only turn the attitude away from the lidar's map, bending the map it
+// builds (docs/odometry.md, Height); with it free, the map stays rigid and the tilt is measured.
 
+#include <ceres/problem.h>
+
+#include <array>
 #include <deque>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "taiga/backend/imu_factor.hpp"
 #include "taiga/backend/state_blocks.hpp"
@@ -47,8 +58,10 @@ class OdometrySmoother {
   explicit OdometrySmoother(OdometrySmootherOptions options = {});
   ~OdometrySmoother();
 
-  /// Starts the graph with one state and its uncertainty.
-  void initialize(const StateEstimate& first);
+  /// Starts the graph with one state and its uncertainty, and the frame's tilt at zero: with
+  /// tilt_sigma_rad > 0 the tilt is estimated from then on under that prior 1-sigma, otherwise
+  /// held at zero (gravity is gravity_world).
+  void initialize(const StateEstimate& first, double tilt_sigma_rad = 0.0);
   bool initialized() const { return !window_.empty(); }
 
   /// Adds a state at t_s, joined to the newest one by the IMU readings preintegrated since then
@@ -58,14 +71,25 @@ class OdometrySmoother {
                          const std::optional<PoseMeasurement>& measurement);
 
   const StateEstimate& latest() const { return latest_; }
+  /// The odom frame's tilt [theta_x; theta_y], rad (zero unless estimated), and gravity in the
+  /// odom frame with it.
+  Eigen::Vector2d tilt() const { return {tilt_[0], tilt_[1]}; }
+  Eigen::Vector3d gravityWorld() const;
 
  private:
   struct Node;
   void optimize();
   void marginalizeOldest();
+  /// Adds the tilt block to `problem`, and to the blocks to linearize when it is estimated
+  /// (constant otherwise).
+  void addTilt(ceres::Problem& problem, std::vector<double*>& linearized);
+
+  bool estimatesTilt() const { return tilt_sigma_rad_ > 0.0; }
 
   OdometrySmootherOptions options_;
   std::deque<std::unique_ptr<Node>> window_;
+  std::array<double, kTiltSize> tilt_{0.0, 0.0};
+  double tilt_sigma_rad_ = 0.0;
   StateEstimate latest_;
 };
 

@@ -21,6 +21,14 @@ namespace taiga::backend {
 constexpr int kPoseSize = 7;
 constexpr int kPoseTangentSize = 6;
 constexpr int kMotionSize = 9;
+/// The odom frame's tilt against gravity (2): [theta_x; theta_y] rad, gravity in the odom frame
+/// = Exp([theta_x, theta_y, 0]) g_nominal (gravityFromTilt). Zero: the frame as levelled.
+constexpr int kTiltSize = 2;
+
+/// Gravity in the world frame for a tilt block, and its Jacobian (3 x 2) with respect to the
+/// tilt: d(Exp(phi) g0)/dphi = -Exp(phi) [g0]x Jr(phi), phi = [theta; 0].
+Eigen::Vector3d gravityFromTilt(const double* tilt, const Eigen::Vector3d& g_nominal,
+                                Eigen::Matrix<double, 3, kTiltSize>* d_gravity_d_tilt = nullptr);
 
 /// One odometry state in the layout above.
 struct StateBlocks {

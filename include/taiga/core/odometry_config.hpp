@@ -111,6 +111,9 @@ struct OdometryConfig final : ConfigSection {
   /// Span of the first scans whose lidar poses and IMU increments level the world frame (gravity
   /// alignment, imu/gravity_alignment.hpp), s; 0 keeps the attitude from the IMU alone.
   double gravity_alignment_s = 2.0;
+  /// Prior 1-sigma of the levelled frame's tilt, deg, which the odometry then keeps estimating
+  /// (backend/odometry_smoother.hpp); 0 holds the frame as levelled.
+  double gravity_tilt_sigma_deg = 1.0;
   ImuNoiseConfig imu;
   HealthConfig health;
 

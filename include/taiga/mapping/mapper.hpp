@@ -68,9 +68,10 @@ class Mapper {
   /// A GNSS fix (recording clock); used when MappingConfig::gnss_fusion is on, ignored
   /// otherwise. It waits for the first keyframe at or after its time (gnss_fusion.hpp).
   void addGnssFix(const GnssFix& fix);
-  /// End of the input: solves the graph once more when GNSS factors arrived since its last
-  /// solve. Call once, after the last keyframe and fix.
-  void finish();
+  /// End of the input: levels the map by R_level_map (the odometry's final estimate of its
+  /// frame's tilt, PoseGraph::rotateMap) and solves the graph once more when GNSS factors
+  /// arrived since its last solve. Call once, after the last keyframe and fix.
+  void finish(const lie::SO3& R_level_map = lie::SO3());
   /// What became of the GNSS fixes and the estimated T_enu_map (none with fusion off).
   std::optional<GnssFusionReport> gnssReport() const;
 
@@ -164,8 +165,9 @@ class MappingThread {
   /// on the thread's timing.
   std::optional<GraphSnapshot> waitForSnapshot(std::size_t keyframe);
   /// Waits until every message is handled, stops the thread, finishes the mapper
-  /// (Mapper::finish) and hands it out. Rethrows what the thread threw.
-  Mapper& finish();
+  /// (Mapper::finish, with R_level_map on the first call) and hands it out. Rethrows what the
+  /// thread threw.
+  Mapper& finish(const lie::SO3& R_level_map = lie::SO3());
 
  private:
   struct KeyframeMessage {

@@ -89,6 +89,12 @@ class PoseGraph {
   /// sigmas of the fix's covariance; the Huber kernel down-weights those above huber_sigmas).
   std::vector<double> gnssWhitenedResiduals() const;
 
+  /// Turns the whole map (every keyframe pose, the absolute positions, T_enu_map with its roll
+  /// and pitch dropped) by R_new_old about the map origin: the odometry's final estimate of its
+  /// frame's tilt levels the map (mapping/mapper.hpp, finish). Relative factors are unchanged,
+  /// so is the cost without GNSS.
+  void rotateMap(const lie::SO3& R_new_old);
+
   /// Solves for every keyframe pose; returns the final cost.
   double optimize();
   /// The cost at the current poses after the last optimize() (0 before); keyframes added since

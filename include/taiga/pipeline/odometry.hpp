@@ -136,6 +136,9 @@ class Odometry {
     local_map_.repose(T_odom_keyframe_at);
   }
   const std::string& initializationNote() const;
+  /// The rotation that levels the odom frame by the odometry's estimate of its tilt against
+  /// gravity (identity without an IMU, or with odometry.gravity_tilt_sigma_deg 0).
+  lie::SO3 R_level_odom() const;
   /// The local map the scans are registered to (between scans, on the odometry's thread).
   const LocalMap& localMap() const { return local_map_; }
 

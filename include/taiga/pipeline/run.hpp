@@ -159,6 +159,11 @@ struct RunSummary {
   double realtime_factor = 0.0;  ///< recording duration / wall time (> 1: faster than the sensor)
   double peak_memory_mb = 0.0;
   std::string initialization;
+  /// The odom frame's tilt against gravity as the odometry estimated it at the end, [theta_x;
+  /// theta_y] deg: gravity in the odom frame is Exp([theta; 0]) (0, 0, -g). The final
+  /// trajectories and the map are turned by Exp(-[theta; 0]) (docs/frames.md); the poses
+  /// published live are not.
+  Eigen::Vector2d frame_tilt_deg = Eigen::Vector2d::Zero();
   HealthReport health;
   std::optional<RealtimeReport> realtime;           ///< with --realtime only
   std::optional<GeorefRunReport> georef;            ///< when the recording has GNSS fixes
