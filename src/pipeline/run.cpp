@@ -105,6 +105,7 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
   auto handle = [&](const io::RecordingEvent& event) {
     const auto* scan = std::get_if<io::Scan>(&event);
     if (scan) scan_log.chargeReadTime(scan->index, std::exchange(read_ms_since_scan, 0.0));
+    if (scan && scan->times_invented) scan_log.countMadeUpTimes();
     slam.add(event);
     if (scan) progress.update(++scans, health.progressNote());
     return scan != nullptr;

@@ -98,6 +98,7 @@ void ScanLog::fillSummary(RunSummary& s) const {
   s.lidar_rejected = rejected_;
   s.lidar_inflated = inflated_;
   s.local_map_rebuilds = local_map_rebuilds_;
+  s.scans_with_made_up_times = made_up_times_;
   if (totals_ms_.empty()) return;
   s.mean_ms = std::accumulate(totals_ms_.begin(), totals_ms_.end(), 0.0) /
               static_cast<double>(totals_ms_.size());

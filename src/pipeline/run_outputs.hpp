@@ -45,6 +45,8 @@ class ScanLog final : public SlamObserver {
   /// The reader's time to read and decode the events up to scan `scan_index` since the previous
   /// scan, for that scan's row.
   void chargeReadTime(std::uint64_t scan_index, double read_ms);
+  /// A scan read without per-point times, which the reader made up (io/point_fields.hpp).
+  void countMadeUpTimes() { ++made_up_times_; }
   void onScan(const ScanOutcome& scan, const lie::SE3& T_map_odom) override;
   void onKeyframe(std::uint64_t id, const ScanOutcome& scan) override;
   void onLocalMapRebuilt() override { ++local_map_rebuilds_; }
@@ -59,7 +61,7 @@ class ScanLog final : public SlamObserver {
   std::map<std::uint64_t, double> read_ms_;  ///< by scan index, until its row is written
   std::vector<double> totals_ms_;
   std::size_t imu_samples_ = 0, keyframes_ = 0, rejected_ = 0, inflated_ = 0;
-  std::size_t local_map_rebuilds_ = 0;
+  std::size_t local_map_rebuilds_ = 0, made_up_times_ = 0;
 };
 
 std::ofstream openOutput(const std::filesystem::path& path);

@@ -141,6 +141,9 @@ struct RunSummary {
   std::size_t scans = 0;            ///< scans read
   std::size_t scans_processed = 0;  ///< scans that gave a state
   std::size_t imu_samples = 0;
+  /// Scans without per-point times, which were made up from the geometry: right for a raw sweep,
+  /// a second deskew for clouds deskewed upstream (recording.deskewed; docs/recordings.md).
+  std::size_t scans_with_made_up_times = 0;
   std::size_t keyframes = 0;
   std::size_t lidar_rejected = 0;
   std::size_t lidar_inflated = 0;
