@@ -10,7 +10,7 @@
 // Covariance: the preintegration's noise covariance for [r_R; r_v; r_p] and the random walk's
 // sigma^2 dt for the biases.
 //
-// with g the odom frame's gravity: g_nominal turned by the tilt block (state_blocks.hpp,
+// Here g is the odom frame's gravity: g_nominal turned by the tilt block (state_blocks.hpp,
 // gravityFromTilt), held constant unless the odometry estimates the frame's tilt.
 //
 // Parameter blocks: pose_i (7), motion_i (9), pose_j (7), motion_j (9), tilt (2); see
