@@ -182,8 +182,8 @@ void OdometrySmoother::optimize() {
   latest_.state = newest.blocks.navState();
   latest_.bias = newest.blocks.bias();
   const Eigen::Index n = H.rows();
-  if (n < 15 + (estimatesTilt() ? kTiltSize : 0) ||
-      !H.allFinite()) {  // not evaluable: the covariance is unknown, not garbage
+  // Not evaluable: the covariance is unknown, not garbage.
+  if (n < marginalSize() || !H.allFinite()) {
     logger().warn(
         "odometry smoother: the window's factors were not finite at {:.3f} s; its "
         "covariance is reported as a weak prior's",
@@ -218,7 +218,7 @@ void OdometrySmoother::marginalizeOldest() {
   linearize(problem, blocks, H, b);
   // Schur complement onto the next state and the tilt (when estimated): H' = H11 - H10 H00^-1
   // H01, b' = b1 - H10 H00^-1 b0.
-  const Eigen::Index m = 15 + (estimatesTilt() ? kTiltSize : 0);
+  const Eigen::Index m = marginalSize();
   const bool evaluated = H.rows() == 15 + m;
   Eigen::MatrixXd H_marginal;
   Eigen::VectorXd b_marginal;

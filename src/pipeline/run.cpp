@@ -297,7 +297,9 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   // The mapping thread's last loop closures belong to the processing time; the export does not.
   const mapping::Mapper& mapper = slam.finish();
   summary.wall_time_s = secondsSince(wall_start);
-  summary.frame_tilt_deg = -slam.odometry().R_level_odom().Log().head<2>() / kRadPerDeg;
+  // The turn SlamSystem::finish levelled the map by; the odometry's trajectory follows below.
+  const lie::SO3 R_level_odom = slam.odometry().R_level_odom();
+  summary.frame_tilt_deg = -R_level_odom.Log().head<2>() / kRadPerDeg;
   if (!summary.frame_tilt_deg.isZero())
     logger().info(
         "the odom frame was {:.2f} deg off level by the odometry's final estimate; the "
@@ -324,8 +326,7 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     summary.trees_work_s = online_trees->workSeconds();
     summary.trees_updates = online_trees->updates();
   }
-  const Trajectory corrected =
-      trajectories.write(out, mapper.graph(), slam.odometry().R_level_odom());
+  const Trajectory corrected = trajectories.write(out, mapper.graph(), R_level_odom);
   writeLoops(out / "loops.csv", mapper.loopAttempts());
   io::writeTum(out / "keyframes.tum", slam.keyframes().trajectory());
   const auto export_start = Clock::now();

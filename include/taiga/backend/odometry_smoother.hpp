@@ -85,6 +85,8 @@ class OdometrySmoother {
   void addTilt(ceres::Problem& problem, std::vector<double*>& linearized);
 
   bool estimatesTilt() const { return tilt_sigma_rad_ > 0.0; }
+  /// Tangent size of what the marginalization keeps: the next state, and the tilt when estimated.
+  Eigen::Index marginalSize() const { return 15 + (estimatesTilt() ? kTiltSize : 0); }
 
   OdometrySmootherOptions options_;
   std::deque<std::unique_ptr<Node>> window_;
