@@ -35,7 +35,7 @@ for head in ${HEADS:-os0-128 hdl-32e}; do
       "$lidar" > "$overrides"
     [[ -f $sim/groundtruth.tum ]] || "$taiga" simulate --scenario handheld-loop --realism "$realism" --seed "$seed" \
       --duration "$duration" --overrides "$overrides" --out "$sim" > "$sim.log" 2>&1
-    sed 's/^  deskewed: false/  deskewed: true/' "$sim/rig.yaml" > "$sim/rig_deskewed.yaml"
+    sed 's/^  deskewed: .*/  deskewed: true/' "$sim/rig.yaml" > "$sim/rig_deskewed.yaml"
     code=0
     "$taiga" run "$sim/recording.bag" --config "$sim/rig_deskewed.yaml" --out "$run" \
       > "$run.log" 2>&1 || code=$?

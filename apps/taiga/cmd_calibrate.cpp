@@ -14,6 +14,7 @@
 #include "taiga/eval/plot.hpp"
 #include "taiga/io/config_yaml.hpp"
 #include "taiga/pipeline/self_calibration.hpp"
+#include "taiga/pipeline/sweep_check.hpp"
 
 namespace taiga::app {
 namespace {
@@ -157,12 +158,17 @@ std::string axes(const Eigen::Vector3<bool>& observable) {
 int run(const CalibrateOptions& options) {
   SystemConfig config = loadConfig(options.config);
   validateAll(config);
+  // Written into the corrected rig.yaml as recording.deskewed: true when the check finds it.
+  const std::optional<pipeline::SweepCheck> sweep =
+      pipeline::resolveDeskewed(options.recording, config);
   const pipeline::SelfCalibration c =
       pipeline::selfCalibrate(options.recording, config, options.calibration);
   const std::filesystem::path out(options.out);
   std::filesystem::create_directories(out);
   writeCorrectedConfig(out / "rig.yaml", config, c, options.recording);
-  const nlohmann::json j = report(options.recording, config, c);
+  nlohmann::json j = report(options.recording, config, c);
+  if (sweep) j["sweep_check"] = {{"verdict", pipeline::toString(sweep->verdict)},
+                                 {"text", sweep->text}};
   std::ofstream(out / "calibration.json") << j.dump(2) << "\n";
   const calib::TimeRotationEstimate& e = c.last;
   fmt::print("stretch    {:.0f}-{:.0f} s, {} passes, {} scan-to-scan rotations used ({} dropped)\n",

@@ -2,11 +2,14 @@
 #include <fmt/format.h>
 
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
 
 #include "command.hpp"
 #include "recording_options.hpp"
 #include "taiga/core/progress.hpp"
 #include "taiga/io/recording_summary.hpp"
+#include "taiga/pipeline/sweep_check.hpp"
 
 namespace taiga::app {
 namespace {
@@ -23,7 +26,22 @@ int runInfo(const InfoOptions& options) {
   const io::RecordingSummary summary =
       io::summarizeRecording(options.recording, config.recording, config.rig, [&](std::size_t n) { progress.update(n); });
   progress.finish();
-  fmt::print("{}", options.json ? io::formatSummaryJson(summary) : io::formatSummaryText(summary));
+  // recording.deskewed: auto judges clouds without per-point times by their seams, as taiga run
+  // will (pipeline/sweep_check.hpp).
+  std::optional<pipeline::SweepCheck> sweep;
+  if (!summary.error && summary.scans.scans_with_invented_times > 0 &&
+      config.recording.deskewed == RecordingConfig::Deskewed::kAuto)
+    sweep = pipeline::checkSweeps(options.recording, config);
+  if (options.json) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(io::formatSummaryJson(summary));
+    if (sweep)
+      j["sweep_check"] = {{"verdict", pipeline::toString(sweep->verdict)}, {"text", sweep->text}};
+    fmt::print("{}\n", j.dump(1));
+  } else {
+    fmt::print("{}", io::formatSummaryText(summary));
+    if (sweep)
+      fmt::print("sweep check (recording.deskewed: auto): {}\n", sweep->text);
+  }
   return summary.error ? kExitBadInput : kExitOk;
 }
 }  // namespace

@@ -17,6 +17,30 @@
 
 namespace taiga::app {
 namespace {
+
+/// How the points' times were taken: said whenever they were not measured.
+void printPointTimes(const pipeline::RunSummary& s) {
+  using Verdict = pipeline::SweepCheck::Verdict;
+  const Verdict verdict = s.sweep_check ? s.sweep_check->verdict : Verdict::kNotNeeded;
+  if (verdict == Verdict::kDeskewedUpstream) {
+    fmt::print("points     the clouds have no per-point times and were deskewed upstream, {}; "
+               "every point was taken at the stamp (recording.deskewed: false if not)\n",
+               s.sweep_check->text);
+  } else if (verdict == Verdict::kRawSweep) {
+    fmt::print("points     {} of {} scans had no per-point times; they were made up from the "
+               "azimuth, the sweep check found {}\n",
+               s.scans_with_made_up_times, s.scans, s.sweep_check->text);
+  } else if (s.scans_with_made_up_times > 0) {
+    fmt::print(
+        "points     {} of {} scans had no per-point times; they were made up from the azimuth "
+        "and the scans deskewed with them{}. Clouds deskewed upstream are then deskewed twice "
+        "(smeared by the motion over a sweep, 20-27 cm on a walk, health still ok): set "
+        "recording.deskewed: true for them (docs/recordings.md)\n",
+        s.scans_with_made_up_times, s.scans,
+        verdict == Verdict::kUndecided ? fmt::format("; the sweep check was {}", s.sweep_check->text)
+                                       : "");
+  }
+}
 struct RunOptions {
   std::string recording, config, out;
   bool realtime = false;
@@ -139,13 +163,7 @@ int run(const RunOptions& options) {
              s.scans, s.scans_processed, s.imu_samples, s.duration_s, s.path_length_m);
   fmt::print("lidar      lidar factors {} rejected, {} inflated; {} keyframes, {} map points\n",
              s.lidar_rejected, s.lidar_inflated, s.keyframes, s.map_points);
-  if (s.scans_with_made_up_times > 0)
-    fmt::print(
-        "points     {} of {} scans had no per-point times; they were made up from the azimuth "
-        "and the scans deskewed with them. Clouds deskewed upstream are then deskewed twice "
-        "(smeared by the motion over a sweep, 20-27 cm on a walk, health still ok): set "
-        "recording.deskewed: true for them (docs/recordings.md)\n",
-        s.scans_with_made_up_times, s.scans);
+  printPointTimes(s);
   printHealth(s.health);
   fmt::print(
       "time       {:.1f} ms median, {:.1f} ms p95, {:.1f} ms p99, {:.1f} ms max per scan on {} "

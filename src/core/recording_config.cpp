@@ -1,5 +1,9 @@
 #include "taiga/core/recording_config.hpp"
 
+#include <array>
+#include <string_view>
+#include <utility>
+
 namespace taiga {
 
 void RecordingConfig::visit(ConfigVisitor& v) {
@@ -10,9 +14,15 @@ void RecordingConfig::visit(ConfigVisitor& v) {
   v.field("scan_period_s", scan_period_s, "s, one lidar sweep; used only to derive missing point times");
   v.field("point_time_field", point_time_field,
           "point field with per-point time; empty: t, time, offset_time or timestamp");
-  v.field("deskewed", deskewed,
-          "true: the clouds were deskewed upstream into the lidar frame at the message stamp; "
-          "every point is taken at the stamp and not deskewed again");
+  static constexpr std::array<std::pair<std::string_view, Deskewed>, 3> kDeskewed{{
+      {"auto", Deskewed::kAuto},
+      {"true", Deskewed::kYes},
+      {"false", Deskewed::kNo},
+  }};
+  enumField(v, "deskewed", deskewed, kDeskewed,
+            "true: the clouds were deskewed upstream into the lidar frame at the message stamp; "
+            "every point is taken at the stamp and not deskewed again. auto: clouds without "
+            "per-point times are judged by their sweeps' seams");
 }
 
 void RecordingConfig::validate() const {

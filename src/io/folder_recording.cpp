@@ -29,7 +29,7 @@ std::optional<double> stampFromName(const std::filesystem::path& file) {
 class FolderScanStream final : public StreamSource {
  public:
   FolderScanStream(std::vector<FolderScanFile> files, const RecordingConfig& config)
-      : files_(std::move(files)), options_{config.scan_period_s, config.point_time_field, config.deskewed} {}
+      : files_(std::move(files)), options_{config.scan_period_s, config.point_time_field, config.pointsAtStamp()} {}
 
   std::string name() const override { return "scans/"; }
   std::vector<std::string> details() const override { return details_; }

@@ -131,6 +131,32 @@ double clockwiseSweep(double start_rad, double azimuth_rad) {
   return sweep;
 }
 
+// A cloud in firing order (column after column, as Velodyne and flattened column-major Ouster
+// clouds are) fires the beams of one column at azimuths up to +-9 deg apart (the OS0's stagger),
+// so near the start some of the first column's points lie counter-clockwise of the first point
+// and the azimuth rule gives them a whole sweep (and some of the last column's none): a tear at
+// the seam. In such a cloud a point's place in the order says which end of the sweep it belongs
+// to. `sweep_fractions` are the clockwise sweeps over 2 pi, in the cloud's order; a fraction
+// more than half a sweep from the point's place is moved by one sweep towards it. Only when at
+// least 90 % of the points lie within a quarter sweep of their place (a cloud published beam
+// after beam lies nowhere near it) and the cloud is not tiny.
+void unwrapInFiringOrder(std::vector<double>& sweep_fractions) {
+  const std::size_t n = sweep_fractions.size();
+  if (n < 100) return;
+  auto place = [n](std::size_t i) { return (static_cast<double>(i) + 0.5) / static_cast<double>(n); };
+  std::size_t near = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = std::abs(sweep_fractions[i] - place(i));
+    near += std::min(d, 1.0 - d) < 0.25;
+  }
+  if (near < 0.9 * static_cast<double>(n)) return;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = sweep_fractions[i] - place(i);
+    if (d > 0.5) sweep_fractions[i] -= 1.0;
+    if (d < -0.5) sweep_fractions[i] += 1.0;
+  }
+}
+
 }  // namespace
 
 std::size_t fieldTypeSize(FieldType type) {
@@ -260,10 +286,10 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
         }
       } else if (organized) {
         t_s = stamp_s + options.scan_period_s * col / points.width;
-      } else {
+      } else {  // a sweep fraction for now, times below
         const double azimuth_rad = std::atan2(p.y(), p.x());
         if (!start_azimuth_rad) start_azimuth_rad = azimuth_rad;
-        t_s = stamp_s + options.scan_period_s * clockwiseSweep(*start_azimuth_rad, azimuth_rad) / (2.0 * std::numbers::pi);
+        t_s = clockwiseSweep(*start_azimuth_rad, azimuth_rad) / (2.0 * std::numbers::pi);
       }
       if (!std::isfinite(t_s)) {
         ++out.dropped_invalid;
@@ -281,6 +307,11 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
     }
   }
 
+  const bool by_azimuth = !options.deskewed && !time_rule.field && !organized;
+  if (by_azimuth) {
+    unwrapInFiringOrder(cloud.times_s);
+    for (double& t_s : cloud.times_s) t_s = stamp_s + options.scan_period_s * t_s;
+  }
   if (options.deskewed) {
     out.time_source = PointTimeSource::kStamp;
     out.time_description = "deskewed upstream (recording.deskewed): every point at the stamp";

@@ -215,7 +215,7 @@ RecordingSummary summarizeRecording(const std::filesystem::path& path, const Rec
   if (!sigmas.empty()) s.gnss.median_horizontal_sigma_m = median(sigmas);
   s.repairs = recording.repairs();
   s.details = recording.streamDetails();
-  addWarnings(s, points_per_scan, recording_config.deskewed);
+  addWarnings(s, points_per_scan, recording_config.pointsAtStamp());
   return s;
 }
 

@@ -235,7 +235,8 @@ bool calibratesAtStart(const SystemConfig& config) {
 /// The SLAM system over `recording` (from `recording_path`, or a live sensor's streams when
 /// `live` is given), its outputs written into options.out_dir.
 RunSummary runRecording(io::Recording& recording, const std::filesystem::path& recording_path,
-                        const SystemConfig& config, std::optional<CalibrationRunReport> calibration,
+                        const SystemConfig& config, std::optional<SweepCheck> sweep_check,
+                        std::optional<CalibrationRunReport> calibration,
                         const RunOptions& options, io::ouster::LiveCapture* live) {
   const std::filesystem::path& out = options.out_dir;
   std::deque<io::RecordingEvent> read_ahead;
@@ -351,6 +352,7 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
   summary.threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   summary.initialization = slam.odometry().initializationNote();
+  summary.sweep_check = sweep_check;
   summary.calibration = calibration;
   writeSummary(out / "summary.json", summary, recording_path, mapper.gnssReport());
   return summary;
@@ -363,6 +365,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
   createOutputDirectory(options.out_dir);
   const ThreadLimit thread_limit(configured.compute.threads);
   SystemConfig config = configured;
+  // Before the calibration, whose passes deskew the scans too.
+  const std::optional<SweepCheck> sweep_check = resolveDeskewed(recording_path, config);
   std::optional<CalibrationRunReport> calibration;
   if (calibratesAtStart(config)) {
     if (options.realtime)  // a live sensor gives no stretch to read ahead
@@ -374,7 +378,8 @@ RunSummary runOdometry(const std::filesystem::path& recording_path, const System
       calibration = calibrateAtStart(recording_path, config);
   }
   io::Recording recording = io::openRecording(recording_path, config.recording, config.rig);
-  return runRecording(recording, recording_path, config, calibration, options, nullptr);
+  return runRecording(recording, recording_path, config, sweep_check, calibration, options,
+                      nullptr);
 }
 
 RunSummary runLive(const SystemConfig& config, const RunOptions& options) {
@@ -398,7 +403,8 @@ RunSummary runLive(const SystemConfig& config, const RunOptions& options) {
             "not on a live sensor: calibrate a recording of the rig with taiga calibrate "
             "and give the run its rig.yaml"};
   io::Recording recording = capture.recording(config.rig.lidar_time_offset_s);
-  return runRecording(recording, capture.name(), config, calibration, options, &capture);
+  return runRecording(recording, capture.name(), config, std::nullopt, calibration, options,
+                      &capture);
 }
 
 }  // namespace taiga::pipeline

@@ -106,6 +106,16 @@ nlohmann::ordered_json calibrationJson(const CalibrationRunReport& c) {
             {"text", c.gyro_noise_text}}}};
 }
 
+/// null when recording.deskewed was configured (nothing was judged).
+nlohmann::ordered_json sweepCheckJson(const std::optional<SweepCheck>& check) {
+  if (!check) return nullptr;
+  return {{"verdict", toString(check->verdict)},
+          {"scans_read", check->scans_read},
+          {"scans_used", check->scans_used},
+          {"seam_ratio", std::exp(check->median_log_ratio)},
+          {"text", check->text}};
+}
+
 }  // namespace
 
 void writeSummary(const std::filesystem::path& path, const RunSummary& s,
@@ -117,6 +127,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
       {"scans_processed", s.scans_processed},
       {"imu_samples", s.imu_samples},
       {"scans_with_made_up_times", s.scans_with_made_up_times},
+      {"sweep_check", sweepCheckJson(s.sweep_check)},
       {"keyframes", s.keyframes},
       {"loop_closures", s.loop_closures},
       {"odometry_corrections",

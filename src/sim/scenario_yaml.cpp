@@ -281,9 +281,10 @@ class OutputSection final : public TableSection<OutputParams> {
 
  private:
   void visitMore(ConfigVisitor& v) override {
-    static constexpr std::string_view kLayouts[] = {"ouster", "velodyne", "deskewed"};
+    static constexpr std::string_view kLayouts[] = {"ouster", "velodyne", "deskewed", "untimed"};
     v.choice("point_layout", params_.point_layout, kLayouts,
-             "ouster (organized, t), velodyne (flat, ring, time), deskewed (flat, no time)");
+             "ouster (organized, t), velodyne (flat, ring, time), deskewed (flat, no time), "
+             "untimed (flat, no time, a raw sweep)");
     static constexpr std::string_view kProfiles[] = {"", "LEGACY", "RNG19_RFL8_SIG16_NIR16",
                                                      "RNG15_RFL8_NIR8"};
     v.choice("pcap_profile", params_.pcap_profile, kProfiles,

@@ -238,6 +238,8 @@ SimulationSummary writeSimulation(const Simulation& simulation,
     } else if (output.point_layout == "deskewed") {
       deskewWithTruth(scan, motion, lidar.T_body_lidar(), lidar_clock_s);
       bag.writeScanAs(io::ScanLayout::kXyzi, kLidarTopic, "os_sensor", scan);
+    } else if (output.point_layout == "untimed") {
+      bag.writeScanAs(io::ScanLayout::kXyzi, kLidarTopic, "os_sensor", scan);
     } else {
       bag.writeScan(kLidarTopic, "os_sensor", scan, grid);
     }

@@ -130,6 +130,36 @@ TEST(PointFields, WithoutTimeFieldTimesFollowTheClockwiseAzimuth) {
   EXPECT_NEAR(d.cloud.times_s[3], 2.075, 1e-9);
 }
 
+// A flat cloud in firing order from a head whose beams fire at azimuths up to 9 deg apart (the
+// OS0's stagger): the first column's points counter-clockwise of the first point belong to the
+// sweep's start, not its end, and the last column's clockwise of it to its end.
+TEST(PointFields, WithoutTimeFieldAStaggeredColumnStaysAtItsEndOfTheSweep) {
+  constexpr int kColumns = 200;
+  constexpr double kStagger_deg[4] = {3.05, 9.15, -3.05, -9.15};  // beam 1 is ahead of beam 0
+  auto pack = [&](bool column_major) {
+    Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}});
+    for (int outer = 0; outer < (column_major ? kColumns : 4); ++outer)
+      for (int inner = 0; inner < (column_major ? 4 : kColumns); ++inner) {
+        const int column = column_major ? outer : inner, beam = column_major ? inner : outer;
+        // Clockwise from azimuth 0 with time; beam 0 is the first point.
+        const double az = (-360.0 * column / kColumns + kStagger_deg[beam] - kStagger_deg[0]) *
+                          std::numbers::pi / 180.0;
+        packer.add({static_cast<float>(std::cos(az)), static_cast<float>(std::sin(az)), 0.0f});
+      }
+    return decodePackedPoints(packer.finish(), 2.0, {.scan_period_s = 0.1}).cloud.times_s;
+  };
+  const std::vector<double> fired = pack(true);
+  constexpr double kStaggerTime_s = 1.1 * 0.1 * 18.3 / 360.0;  // the widest stagger, as time
+  for (int beam = 0; beam < 4; ++beam) {
+    EXPECT_NEAR(fired[beam], 2.0, kStaggerTime_s) << beam;                          // column 0
+    EXPECT_NEAR(fired[4 * (kColumns - 1) + beam], 2.1, kStaggerTime_s) << beam;  // the last
+  }
+  // Beam after beam the order says nothing of the time: the azimuth rule alone, so beam 1's
+  // first column (counter-clockwise of the start) is taken for the sweep's end.
+  const std::vector<double> by_beam = pack(false);
+  EXPECT_NEAR(by_beam[kColumns], 2.1, kStaggerTime_s);
+}
+
 TEST(PointFields, OrganizedWithoutTimeFieldUsesTheColumn) {
   Packer packer({{"x", 0, F::kFloat32}, {"y", 4, F::kFloat32}, {"z", 8, F::kFloat32}});
   for (int i = 0; i < 8; ++i) packer.add({1, 1, 1});

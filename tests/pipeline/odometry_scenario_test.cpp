@@ -54,7 +54,8 @@ struct RunSetup {
   std::string rig_file = "rig.yaml";  ///< as its user would write it, or rig_truth.yaml
   bool calibrate_at_start = false;    ///< calibration.at_start (docs/calibration.md)
   int beams = 64;                     ///< lidar beams; 0: the scenario's (or overrides') own
-  bool deskewed = false;              ///< the documented switch recording.deskewed: true
+  /// recording.deskewed; auto (the default) judges clouds without per-point times by their seams
+  RecordingConfig::Deskewed deskewed = RecordingConfig::Deskewed::kAuto;
   bool lidar_only = false;            ///< odometry.imu_use: lidar_only
 };
 
@@ -430,7 +431,9 @@ TEST(OdometryScenario, LidarOnlyAtTwoHertzThroughFastTurnsStaysWithinDecimetres)
     test::TempDir dir;
     const ScenarioRun run = simulateAndRun(
         "handheld-loop", 60.0, head.seed, dir.path() / std::to_string(head.seed),
-        {.overrides = head.lidar + kept_at_2_hz, .beams = head.beams, .deskewed = true});
+        {.overrides = head.lidar + kept_at_2_hz,
+         .beams = head.beams,
+         .deskewed = RecordingConfig::Deskewed::kYes});
     EXPECT_EQ(run.summary.imu_samples, 0u);
     EXPECT_GT(run.summary.path_length_m, 70.0);
     EXPECT_EQ(run.summary.health.lost, 0u);

@@ -18,9 +18,15 @@ struct RecordingConfig final : ConfigSection {
   double scan_period_s = 0.1;
   /// Point field holding per-point time; empty recognizes t, time, offset_time, timestamp.
   std::string point_time_field;
-  /// The clouds were deskewed (motion-compensated) upstream into the lidar frame at the message
-  /// stamp: every point is taken at the stamp and nothing is deskewed again.
-  bool deskewed = false;
+  /// Whether the clouds were deskewed (motion-compensated) upstream into the lidar frame at the
+  /// message stamp: then every point is taken at the stamp and nothing is deskewed again. Auto:
+  /// clouds with per-point times are raw sweeps; for clouds without, `taiga run` and
+  /// `taiga calibrate` tell from the sweeps' seams (pipeline/sweep_check.hpp) and say what they
+  /// found.
+  enum class Deskewed { kAuto, kYes, kNo };
+  Deskewed deskewed = Deskewed::kAuto;
+  /// Every point at the stamp: deskewed upstream, as configured or as the sweep check found.
+  bool pointsAtStamp() const { return deskewed == Deskewed::kYes; }
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

@@ -58,7 +58,7 @@ struct ScanGrid {
 enum class ScanLayout {
   kVelodyne,  ///< velodyne_pointcloud XYZIRT: x y z intensity (float32), ring (uint16), time
               ///< (float32, s after the header stamp); flat
-  kXyzi,      ///< x y z intensity (float32) only, flat: a cloud deskewed upstream, no time field
+  kXyzi,      ///< x y z intensity (float32) only, flat, no time: deskewed upstream, or untimed
 };
 
 /// Writes a bag. Message times in the bag are the events' times (a scan's end), so that the bag's

@@ -33,6 +33,7 @@
 
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/ouster/live.hpp"
+#include "taiga/pipeline/sweep_check.hpp"
 
 namespace taiga::pipeline {
 
@@ -144,6 +145,9 @@ struct RunSummary {
   /// Scans without per-point times, which were made up from the geometry: right for a raw sweep,
   /// a second deskew for clouds deskewed upstream (recording.deskewed; docs/recordings.md).
   std::size_t scans_with_made_up_times = 0;
+  /// recording.deskewed: auto judged by the sweeps' seams before the run (sweep_check.hpp);
+  /// empty when the configuration set it.
+  std::optional<SweepCheck> sweep_check;
   std::size_t keyframes = 0;
   std::size_t lidar_rejected = 0;
   std::size_t lidar_inflated = 0;

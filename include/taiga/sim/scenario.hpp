@@ -204,7 +204,8 @@ struct OutputParams {
   /// `ouster`: the Ouster driver's organized cloud with per-point `t`; `velodyne`: a flat cloud
   /// with `ring` and `time` (velodyne_pointcloud); `deskewed`: a flat x y z intensity cloud
   /// already deskewed (with the true motion) into the lidar frame at the header stamp, the
-  /// scan's start, without a time field.
+  /// scan's start, without a time field; `untimed`: the same flat cloud as the sensor swept it
+  /// (not deskewed), as a driver that drops the time field publishes it.
   std::string point_layout = "ouster";
   int scan_stride = 1;  ///< keep every n-th scan (5: a 2 Hz keyframe sequence from a 10 Hz lidar)
   bool imu = true;      ///< write the IMU topic

@@ -87,7 +87,7 @@ class BagDemux {
  public:
   BagDemux(const std::filesystem::path& path, const std::vector<std::string>& topics, const RecordingConfig& config)
       : path_(path), bag_(openBag(path)), view_(*bag_, rosbag::TopicQuery(topics)), it_(view_.begin()),
-        point_options_{config.scan_period_s, config.point_time_field, config.deskewed} {}
+        point_options_{config.scan_period_s, config.point_time_field, config.pointsAtStamp()} {}
 
   std::optional<RecordingEvent> next(const std::string& topic) {
     std::deque<RecordingEvent>& queue = queues_[topic];
