@@ -104,8 +104,8 @@ void addWarnings(RecordingSummary& s, const std::vector<std::size_t>& points_per
   }
   if (s.scans.scans_with_invented_times > 0) {
     s.warnings.push_back(fmt::format("{} of {} scans have no per-point time field: taiga invents times from the geometry over "
-                                     "recording.scan_period_s and deskews with them; if the clouds were deskewed upstream, set "
-                                     "recording.deskewed: true",
+                                     "recording.scan_period_s and deskews with them, unless the clouds were deskewed upstream "
+                                     "(recording.deskewed: true, or auto: judged by the sweeps' seams)",
                                      s.scans.scans_with_invented_times, points_per_scan.size()));
   } else if (lidar && lidar->count >= 2 && lidar->median_interval_s > 0 && !deskewed) {
     const double ratio = s.scans.median_span_s / lidar->median_interval_s;
