@@ -307,11 +307,6 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
     }
   }
 
-  const bool by_azimuth = !options.deskewed && !time_rule.field && !organized;
-  if (by_azimuth) {
-    unwrapInFiringOrder(cloud.times_s);
-    for (double& t_s : cloud.times_s) t_s = stamp_s + options.scan_period_s * t_s;
-  }
   if (options.deskewed) {
     out.time_source = PointTimeSource::kStamp;
     out.time_description = "deskewed upstream (recording.deskewed): every point at the stamp";
@@ -325,7 +320,9 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
   } else if (organized) {
     out.time_source = PointTimeSource::kColumnIndex;
     out.time_description = fmt::format("no time field: derived from the column index over a {} s sweep", options.scan_period_s);
-  } else {
+  } else {  // the loop left sweep fractions
+    unwrapInFiringOrder(cloud.times_s);
+    for (double& t_s : cloud.times_s) t_s = stamp_s + options.scan_period_s * t_s;
     out.time_source = PointTimeSource::kAzimuth;
     out.time_description = fmt::format("no time field: derived from the clockwise azimuth over a {} s sweep", options.scan_period_s);
   }

@@ -54,39 +54,41 @@ std::optional<Plane> fitPlane(const std::vector<Eigen::Vector3d>& points,
   return Plane{eigen.eigenvectors().col(0), mean};
 }
 
-/// The gyro's rotation over the sweep, as poses (rotation only) every 10 ms from t_start_s.
+/// The gyro's rotation over the sweep, as poses (rotation only) every 10 ms from t_start_s, each
+/// the previous one turned by the gyro over the step.
 Trajectory gyroSweep(const std::vector<calib::GyroReading>& gyro, const io::Scan& scan) {
   Trajectory sweep;
   const double span_s = scan.t_end_s - scan.t_start_s;
   const int steps = std::max(1, static_cast<int>(std::ceil(span_s / 0.01)));
-  for (int k = 0; k <= steps; ++k) {
-    const double t_s = scan.t_start_s + span_s * k / steps;
-    sweep.append(t_s, lie::SE3(calib::integrateGyro(gyro, scan.t_start_s, t_s,
-                                                    Eigen::Vector3d::Zero()),
-                               Eigen::Vector3d::Zero()));
+  lie::SO3 R_start_t;
+  double t_s = scan.t_start_s;
+  sweep.append(t_s, lie::SE3());
+  for (int k = 1; k <= steps; ++k) {
+    const double t_next_s = scan.t_start_s + span_s * k / steps;
+    R_start_t = R_start_t * calib::integrateGyro(gyro, t_s, t_next_s, Eigen::Vector3d::Zero());
+    t_s = t_next_s;
+    sweep.append(t_s, lie::SE3(R_start_t, Eigen::Vector3d::Zero()));
   }
   return sweep;
+}
+
+/// Each point's place in the scan's sweep: 0 at its first firing, 1 at its last.
+std::vector<double> sweepFractions(const PointCloud& cloud, const io::Scan& scan) {
+  std::vector<double> u(cloud.size());
+  const double span_s = scan.t_end_s - scan.t_start_s;
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] = (cloud.times_s[i] - scan.t_start_s) / span_s;
+  return u;
 }
 
 /// The scan's points near its seam (the first and last kWedge of the sweep); the rest are not
 /// needed and not kept.
 io::Scan seamOnly(const io::Scan& scan) {
   io::Scan seam = scan;
-  const double span_s = scan.t_end_s - scan.t_start_s;
-  std::vector<std::uint8_t> keep(scan.cloud_in_lidar.size());
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    const double u = (scan.cloud_in_lidar.times_s[i] - scan.t_start_s) / span_s;
-    keep[i] = u < kWedge || u > 1.0 - kWedge;
-  }
+  const std::vector<double> u = sweepFractions(scan.cloud_in_lidar, scan);
+  std::vector<std::uint8_t> keep(u.size());
+  for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = u[i] < kWedge || u[i] > 1.0 - kWedge;
   seam.cloud_in_lidar.keepWhere(keep);
   return seam;
-}
-
-std::vector<double> sweepFractions(const PointCloud& cloud, const io::Scan& scan) {
-  std::vector<double> u(cloud.size());
-  const double span_s = scan.t_end_s - scan.t_start_s;
-  for (std::size_t i = 0; i < u.size(); ++i) u[i] = (cloud.times_s[i] - scan.t_start_s) / span_s;
-  return u;
 }
 
 /// A scan near its seam with the gyro's turn over its sweep.
@@ -209,10 +211,10 @@ SweepCheck checkSweeps(const std::filesystem::path& path, const SystemConfig& co
     const Trajectory still({{scan.t_start_s, lie::SE3()}, {scan.t_end_s, lie::SE3()}});
     const PointCloud as_given = preparation.deskewedInBody(scan, still);
     const PointCloud unturned = preparation.deskewedInBody(scan, turned);
-    const std::optional<double> given_m =
-        seamMismatch_m(as_given.positions, sweepFractions(as_given, scan));
-    const std::optional<double> unturned_m =
-        seamMismatch_m(unturned.positions, sweepFractions(unturned, scan));
+    // The same points in the same order both ways (the deskew keeps the channels).
+    const std::vector<double> u = sweepFractions(as_given, scan);
+    const std::optional<double> given_m = seamMismatch_m(as_given.positions, u);
+    const std::optional<double> unturned_m = seamMismatch_m(unturned.positions, u);
     if (given_m && unturned_m && *given_m > 0.0 && *unturned_m > 0.0)
       log_ratios.push_back(std::log(*given_m / *unturned_m));
   }
