@@ -13,6 +13,11 @@ void CalibrationConfig::visit(ConfigVisitor& v) {
           "deg; a rotation less certain than this about an axis stays as configured");
   v.field("max_translation_sigma_m", max_translation_sigma_m,
           "m; a lever arm less certain than this along a direction stays as configured");
+  v.field("track_offset", track_offset,
+          "true: taiga run keeps estimating rig.lidar_time_offset_s from its last track_window_s "
+          "of scans and applies it (a lidar clock drifts against the IMU's)");
+  v.field("track_window_s", track_window_s, "s of scans each re-estimate of the offset uses");
+  v.field("track_every_s", track_every_s, "s between re-estimates of the offset");
 }
 
 void CalibrationConfig::validate() const {
@@ -20,6 +25,8 @@ void CalibrationConfig::validate() const {
   requireInRange("max_offset_sigma_s", max_offset_sigma_s, 1e-5, 0.1, "s");
   requireInRange("max_rotation_sigma_deg", max_rotation_sigma_deg, 0.001, 10.0, "deg");
   requireInRange("max_translation_sigma_m", max_translation_sigma_m, 0.0001, 1.0, "m");
+  requireInRange("track_window_s", track_window_s, 5.0, 600.0, "s");
+  requireInRange("track_every_s", track_every_s, 1.0, 600.0, "s");
 }
 
 }  // namespace taiga

@@ -21,13 +21,14 @@ double eventTime(const RecordingEvent& event) {
   return std::visit(visitor, event);
 }
 
-namespace {
-
 void shiftScanTimes(Scan& scan, double offset_s) {
   scan.t_start_s += offset_s;
   scan.t_end_s += offset_s;
   for (double& t : scan.cloud_in_lidar.times_s) t += offset_s;
+  scan.lidar_time_offset_s += offset_s;
 }
+
+namespace {
 
 }  // namespace
 
@@ -40,7 +41,8 @@ struct Recording::Stream {
 
 Recording::Recording(std::string source, std::vector<std::unique_ptr<StreamSource>> streams,
                      double lidar_time_offset_s)
-    : source_(std::move(source)), lidar_time_offset_s_(lidar_time_offset_s) {
+    : source_(std::move(source)),
+      lidar_time_offset_s_(std::make_unique<std::atomic<double>>(lidar_time_offset_s)) {
   for (auto& s : streams) streams_.push_back(Stream{std::move(s), std::nullopt});
 }
 
@@ -70,7 +72,7 @@ void Recording::refill(Stream& stream) {
       stream.exhausted = true;
       return;
     }
-    if (auto* scan = std::get_if<Scan>(&*event)) shiftScanTimes(*scan, lidar_time_offset_s_);
+    if (auto* scan = std::get_if<Scan>(&*event)) shiftScanTimes(*scan, lidar_time_offset_s_->load());
     const double t_s = eventTime(*event);
     if (t_s > stream.last_time_s) {
       stream.last_time_s = t_s;

@@ -96,21 +96,22 @@ bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
 /// Returns the scans read and, under --realtime, what a live run would have seen.
 std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEvent> read_ahead,
                           const RunOptions& options, const LiveConfig* live, SlamSystem& slam,
-                          ScanLog& scan_log, const HealthLog& health,
+                          ScanLog& scan_log, const HealthLog& health, ClockTracker* clock,
                           std::optional<RealtimeReport>& realtime) {
   Progress progress("taiga run", 0, "scans", stderr,
                     options.show_progress && isatty(fileno(stderr)));
   std::size_t scans = 0;
   double read_ms_since_scan = 0.0;  // the reader's time since the previous scan, IMU included
-  auto handle = [&](const io::RecordingEvent& event) {
-    const auto* scan = std::get_if<io::Scan>(&event);
+  auto handle = [&](io::RecordingEvent& event) {
+    auto* scan = std::get_if<io::Scan>(&event);
     if (scan) scan_log.chargeReadTime(scan->index, std::exchange(read_ms_since_scan, 0.0));
     if (scan && scan->times_invented) scan_log.countMadeUpTimes();
+    if (scan && clock != nullptr) clock->adjust(*scan);
     slam.add(event);
     if (scan) progress.update(++scans, health.progressNote());
     return scan != nullptr;
   };
-  for (const io::RecordingEvent& event : read_ahead) handle(event);
+  for (io::RecordingEvent& event : read_ahead) handle(event);
   constexpr std::size_t kReadAheadScans = 3;
   const auto pacing = live != nullptr    ? RecordingFeed::Pacing::kLive
                       : options.realtime ? RecordingFeed::Pacing::kSensorRate
@@ -240,10 +241,10 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
                         const RunOptions& options, io::ouster::LiveCapture* live) {
   const std::filesystem::path& out = options.out_dir;
   std::deque<io::RecordingEvent> read_ahead;
-  SlamSystem slam(config,
-                  {.keyframe_dir = out / "keyframes",
-                   .lidar_only = useLidarOnly(recording, config.odometry.imu_use, read_ahead),
-                   .moving_boxes_body = movingBoxes(options.moving_boxes_file)});
+  const bool lidar_only = useLidarOnly(recording, config.odometry.imu_use, read_ahead);
+  SlamSystem slam(config, {.keyframe_dir = out / "keyframes",
+                           .lidar_only = lidar_only,
+                           .moving_boxes_body = movingBoxes(options.moving_boxes_file)});
   TrajectoryRecorder trajectories;
   ScanLog scan_log(out);
   GnssRecorder gnss(config);
@@ -278,11 +279,18 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
         })
                      : nullptr));
 
+  std::optional<ClockTracker> clock;
+  if (config.calibration.track_offset && !lidar_only) {
+    clock.emplace(config.calibration, config.rig,
+                  [&recording](double offset_s) { recording.setLidarTimeOffset(offset_s); });
+    slam.addObserver(*clock);
+  }
+
   RunSummary summary;
   const auto wall_start = Clock::now();
   summary.scans = feedRecording(recording, std::move(read_ahead), options,
                                 live != nullptr ? &config.live : nullptr, slam, scan_log, health,
-                                summary.realtime);
+                                clock ? &*clock : nullptr, summary.realtime);
   if (live != nullptr) {
     live->setImuTap(nullptr);  // before pose_stream goes
     summary.live = live->stats();
@@ -306,6 +314,11 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
         "the odom frame was {:.2f} deg off level by the odometry's final estimate; the "
         "trajectories and the map are levelled by it",
         summary.frame_tilt_deg.norm());
+  if (clock) {
+    summary.clock = clock->finish();
+    logger().info("clock: {}", summary.clock->text);
+    writeClockWindows(out / "clock_offset.csv", summary.clock->windows);
+  }
   scan_log.fillSummary(summary);
   summary.health = health.finish();
   std::vector<Reattachment>& reattached = summary.health.reattached;

@@ -122,4 +122,13 @@ void writeLoops(const std::filesystem::path& path,
   }
 }
 
+void writeClockWindows(const std::filesystem::path& path, const std::vector<ClockWindow>& windows) {
+  std::ofstream out = openOutput(path);
+  out << "t_s,estimate_s,sigma_s,observable,applied_s,rotation_change_deg,increments,note\n";
+  for (const ClockWindow& w : windows)
+    out << fmt::format("{:.3f},{:.7f},{:.7f},{},{:.7f},{:.4f},{},\"{}\"\n", w.t_s, w.estimate_s,
+                       w.sigma_s, w.observable ? 1 : 0, w.applied_s, w.rotation_change_deg,
+                       w.increments, w.failed);
+}
+
 }  // namespace taiga::pipeline

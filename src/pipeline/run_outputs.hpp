@@ -70,6 +70,9 @@ std::ofstream openOutput(const std::filesystem::path& path);
 void writeLoops(const std::filesystem::path& path,
                 const std::vector<mapping::LoopRecord>& attempts);
 
+/// clock_offset.csv: every re-estimate of the lidar-IMU time offset (clock_tracker.hpp).
+void writeClockWindows(const std::filesystem::path& path, const std::vector<ClockWindow>& windows);
+
 /// summary.json.
 void writeSummary(const std::filesystem::path& path, const RunSummary& summary,
                   const std::filesystem::path& recording,

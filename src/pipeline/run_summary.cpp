@@ -106,6 +106,19 @@ nlohmann::ordered_json calibrationJson(const CalibrationRunReport& c) {
             {"text", c.gyro_noise_text}}}};
 }
 
+nlohmann::ordered_json clockJson(const ClockTrackingReport& c) {
+  const auto optional = [](const std::optional<double>& v) -> nlohmann::ordered_json {
+    return v ? nlohmann::ordered_json(*v) : nlohmann::ordered_json(nullptr);
+  };
+  return {{"offset_first_s", c.offset_first_s},
+          {"offset_last_s", c.offset_last_s},
+          {"windows", c.windows.size()},
+          {"held", c.held},
+          {"drift_ppm", optional(c.drift_ppm)},
+          {"drift_sigma_ppm", optional(c.drift_sigma_ppm)},
+          {"text", c.text}};
+}
+
 /// null when recording.deskewed was configured (nothing was judged).
 nlohmann::ordered_json sweepCheckJson(const std::optional<SweepCheck>& check) {
   if (!check) return nullptr;
@@ -209,6 +222,7 @@ void writeSummary(const std::filesystem::path& path, const RunSummary& s,
   }
   if (gnss_fusion) j["gnss_fusion"] = gnssFusionJson(*gnss_fusion);
   if (s.calibration) j["calibration"] = calibrationJson(*s.calibration);
+  if (s.clock) j["clock"] = clockJson(*s.clock);
   openOutput(path) << j.dump(2) << "\n";
 }
 

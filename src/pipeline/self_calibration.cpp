@@ -12,6 +12,7 @@
 #include "taiga/core/log.hpp"
 #include "taiga/io/recording.hpp"
 #include "taiga/pipeline/odometry.hpp"
+#include "taiga/pipeline/rotation_increments.hpp"
 
 namespace taiga::pipeline {
 namespace {
@@ -23,10 +24,6 @@ struct PassData {
   std::size_t scans = 0;
 };
 
-/// A scan whose registration is a measurement of the body's rotation.
-bool measured(const ScanOutcome& o) {
-  return o.lidar == LidarFactor::kUsed && o.health.status != ScanStatus::kLost;
-}
 
 /// The odometry over [from_s, to_s] of the recording (s after its first scan) with `rig`: the
 /// registrations' rotation increments between consecutive measured scans, and the gyro readings
@@ -39,28 +36,17 @@ PassData runPass(const std::filesystem::path& path, const SystemConfig& config,
   const Eigen::Matrix3d R_body_imu = rig.T_body_imu.rotation().matrix();
   PassData data;
   std::optional<double> first_scan_s;
-  struct Previous {  // what the next scan needs of the one before it
-    std::uint64_t scan_index = 0;
-    double t_s = 0.0;
-    bool measured = false;
-    lie::SO3 R_odom_body;
-  };
-  std::optional<Previous> previous;
+  RotationIncrements increments;
   std::vector<std::vector<StampedPose>>& chains = data.lever_arm.chains;
   auto take = [&](const ScanOutcome& o) {
-    const lie::SE3& T_odom_body = o.registration.T_target_source;
-    const bool follows = previous && previous->measured && measured(o) &&
-                         o.scan_index == previous->scan_index + 1 && !o.T_odom_unlevelled;
-    if (follows)
-      data.increments.push_back(
-          {previous->t_s, o.t_s, (previous->R_odom_body.inverse() * T_odom_body.rotation()).Log()});
+    const std::optional<calib::RotationIncrement> increment = increments.take(o);
+    if (increment) data.increments.push_back(*increment);
     // Poses for the lever arm: only in the levelled frame, the levelling scan not included.
     if (o.T_odom_unlevelled) chains.clear();
-    if (measured(o) && !o.T_odom_unlevelled) {
-      if (!follows || chains.empty()) chains.emplace_back();
-      chains.back().push_back({o.t_s, T_odom_body});
+    if (measuredByLidar(o) && !o.T_odom_unlevelled) {
+      if (!increment || chains.empty()) chains.emplace_back();
+      chains.back().push_back({o.t_s, o.registration.T_target_source});
     }
-    previous = Previous{o.scan_index, o.t_s, measured(o), T_odom_body.rotation()};
   };
   while (std::optional<io::RecordingEvent> event = recording.next()) {
     if (const auto* imu = std::get_if<ImuSample>(&*event)) {

@@ -82,6 +82,9 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
                               rig_error.lidar_time_offset_s == 0.0 &&
                               rig_error.lidar_clock_drift_ppm == 0.0;
   config.calibration.at_start = !(truth || stated_exactly);
+  // The true rig is exact at the start and stays the floor runs are compared with; a drifting
+  // clock in a stated rig is for the run to follow (pipeline/clock_tracker.hpp).
+  config.calibration.track_offset = config.calibration.at_start;
   if (!simulation.scenario().output.pcap_profile.empty())  // taiga run --live --config rig.yaml
     config.live.metadata = std::filesystem::absolute(path.parent_path() / "capture.json").string();
   if (simulation.lidar().rows() >= 64) {

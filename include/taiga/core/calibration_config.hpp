@@ -18,6 +18,12 @@ struct CalibrationConfig final : ConfigSection {
   double max_offset_sigma_s = 0.002;
   double max_rotation_sigma_deg = 0.1;
   double max_translation_sigma_m = 0.01;
+  /// `taiga run` follows the lidar-IMU time offset through the run: a free-running lidar clock
+  /// drifts against the IMU's by 10-50 ppm, 18 ms after 30 min at 10 ppm (pipeline/
+  /// clock_tracker.hpp). Re-estimated every track_every_s from the last track_window_s of scans.
+  bool track_offset = true;
+  double track_window_s = 30.0;
+  double track_every_s = 10.0;
 
   void visit(ConfigVisitor& v) override;
   void validate() const override;

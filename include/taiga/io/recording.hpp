@@ -6,6 +6,7 @@
 // event time. A scan's event time is the time of its last point, because a scan can be processed
 // only once it is complete (and the IMU up to its end has arrived).
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -31,12 +32,18 @@ struct Scan {
   /// The per-point times were made up from the geometry (no time field: column or azimuth over
   /// recording.scan_period_s), not measured.
   bool times_invented = false;
+  /// The lidar clock's offset (rig.lidar_time_offset_s, or the run's tracked value) that the
+  /// Recording added to the times above.
+  double lidar_time_offset_s = 0.0;
 };
 
 using RecordingEvent = std::variant<Scan, ImuSample, GnssFix>;
 
 /// The time at which an event is complete: a scan's end, a sample's or a fix's time.
 double eventTime(const RecordingEvent& event);
+
+/// Adds offset_s to every time of the scan and to its lidar_time_offset_s.
+void shiftScanTimes(Scan& scan, double offset_s);
 
 /// One sensor stream of a recording, delivering events of one kind in non-decreasing time order.
 class StreamSource {
@@ -82,6 +89,11 @@ class Recording {
   /// details() of every stream, prefixed with the stream's name.
   std::vector<std::string> streamDetails() const;
   const RecordingRepairs& repairs() const { return repairs_; }
+  /// The offset added to the scans read from now on (thread-safe: a run's reader thread may
+  /// already have read a few scans ahead with the previous one). The streams are merged in time
+  /// order after it, so the scans come after the IMU readings that precede them.
+  void setLidarTimeOffset(double offset_s) { lidar_time_offset_s_->store(offset_s); }
+  double lidarTimeOffset() const { return lidar_time_offset_s_->load(); }
 
  private:
   struct Stream;
@@ -89,7 +101,7 @@ class Recording {
 
   std::string source_;
   std::vector<Stream> streams_;
-  double lidar_time_offset_s_;
+  std::unique_ptr<std::atomic<double>> lidar_time_offset_s_;  // movable, unlike the atomic
   RecordingRepairs repairs_;
 };
 

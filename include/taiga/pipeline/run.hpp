@@ -33,6 +33,7 @@
 
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/ouster/live.hpp"
+#include "taiga/pipeline/clock_tracker.hpp"
 #include "taiga/pipeline/sweep_check.hpp"
 
 namespace taiga::pipeline {
@@ -175,6 +176,9 @@ struct RunSummary {
   std::optional<RealtimeReport> realtime;           ///< with --realtime only
   std::optional<GeorefRunReport> georef;            ///< when the recording has GNSS fixes
   std::optional<CalibrationRunReport> calibration;  ///< with calibration.at_start
+  /// With calibration.track_offset: the lidar-IMU time offset followed through the run
+  /// (clock_tracker.hpp); its windows are in clock_offset.csv.
+  std::optional<ClockTrackingReport> clock;
   std::optional<io::ouster::LiveStats> live;        ///< taiga run --live: the packets' fate
   /// live.pose_udp / live.foxglove: poses sent; Foxglove clients and messages (and those dropped
   /// for a client too far behind, and kept messages dropped from the history that late clients
