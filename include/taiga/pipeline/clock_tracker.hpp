@@ -7,7 +7,7 @@
 // last `track_window_s` of the run's own registrations and gyro readings, with the estimator of
 // `taiga calibrate` (calib/time_rotation.hpp, equation (1)), and applied: the latest window's
 // value, or, once three windows show a drift beyond 2 sigma, the drift line fitted through them,
-// extrapolated to the present. A window whose motion does not show the offset (held by the
+// which the offset then follows scan by scan until the next window. A window whose motion does not show the offset (held by the
 // estimator's observability test) changes nothing and is counted.
 //
 // The estimate (about 0.2 s of CPU) runs on its own thread; its result applies from a fixed
@@ -42,6 +42,12 @@ struct ClockWindow {
   double rotation_change_deg = 0.0;  ///< the window's R_body_lidar against the run's (not applied)
   std::size_t increments = 0;
   std::string failed;         ///< why the window gave no estimate; empty when it did
+};
+
+/// offset(t) = value_s + slope * (t - t_mean_s), t on the IMU clock.
+struct ClockLine {
+  double t_mean_s = 0.0, value_s = 0.0;  ///< the windows' weighted mean time and the line there
+  double slope = 0.0, slope_sigma = 0.0;  ///< s per s (1e-6: 1 ppm)
 };
 
 struct ClockTrackingReport {
@@ -86,8 +92,9 @@ class ClockTracker final : public SlamObserver {
   double offsetOf(std::uint64_t scan_index) const;
   void start(double t_now_s, std::uint64_t scan_index);
   void apply();
-  /// The offset to apply at t_s from the observable windows: the drift line when significant.
-  double predicted(double t_s, double latest_s) const;
+  /// The line through the observable windows of the last kDriftSpan_s before t_s, when its
+  /// slope is beyond 2 sigma.
+  std::optional<ClockLine> driftLine(double t_s) const;
   void trim(double t_now_s);
 
   CalibrationConfig config_;
@@ -100,6 +107,7 @@ class ClockTracker final : public SlamObserver {
   RotationIncrements take_;
   std::optional<double> first_scan_s_, last_estimate_s_;
   std::optional<Pending> pending_;
+  std::optional<ClockLine> drift_line_;  ///< the offset follows it between windows
   ClockTrackingReport report_;
 };
 
