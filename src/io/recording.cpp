@@ -28,10 +28,6 @@ void shiftScanTimes(Scan& scan, double offset_s) {
   scan.lidar_time_offset_s += offset_s;
 }
 
-namespace {
-
-}  // namespace
-
 struct Recording::Stream {
   std::unique_ptr<StreamSource> source;
   std::optional<RecordingEvent> head;  // the next event of this stream, already read
@@ -72,7 +68,8 @@ void Recording::refill(Stream& stream) {
       stream.exhausted = true;
       return;
     }
-    if (auto* scan = std::get_if<Scan>(&*event)) shiftScanTimes(*scan, lidar_time_offset_s_->load());
+    if (auto* scan = std::get_if<Scan>(&*event))
+      shiftScanTimes(*scan, lidar_time_offset_s_->load());
     const double t_s = eventTime(*event);
     if (t_s > stream.last_time_s) {
       stream.last_time_s = t_s;

@@ -12,13 +12,15 @@
 namespace taiga::pipeline {
 namespace {
 
-/// The window's grid spans this much around the offset in use: the offset moves by microseconds
-/// per window, and a grid of +-200 ms (taiga calibrate's) would cost ten times as much.
+/// The window's grid spans this much around the offset in use: a clock 50 ppm off moves it by
+/// 0.5 ms per window, and a grid of +-200 ms (taiga calibrate's) would cost 20 times as much.
+/// An offset further off is not found here: that is calibration.at_start's job.
 constexpr double kMaxOffsetChange_s = 0.01;
 /// The drift line takes the windows of this much time before the present (a crystal's rate
 /// changes with its temperature over minutes).
 constexpr double kDriftSpan_s = 300.0;
 
+double weight(const ClockWindow& w) { return 1.0 / std::max(w.sigma_s * w.sigma_s, 1e-12); }
 
 /// Weighted least squares line through the windows' estimates (weights 1 / sigma^2). Windows
 /// overlap (window_s / every_s of them share each scan), so the slope's formal 1-sigma is
@@ -26,17 +28,15 @@ constexpr double kDriftSpan_s = 300.0;
 std::optional<ClockLine> fitLine(const std::vector<const ClockWindow*>& windows, double overlap) {
   double sw = 0.0, st = 0.0, sy = 0.0;
   for (const ClockWindow* w : windows) {
-    const double weight = 1.0 / (w->sigma_s * w->sigma_s);
-    sw += weight;
-    st += weight * w->t_s;
-    sy += weight * w->estimate_s;
+    sw += weight(*w);
+    st += weight(*w) * w->t_s;
+    sy += weight(*w) * w->estimate_s;
   }
   ClockLine line{.t_mean_s = st / sw, .value_s = sy / sw};
   double stt = 0.0, sty = 0.0;
   for (const ClockWindow* w : windows) {
-    const double weight = 1.0 / (w->sigma_s * w->sigma_s);
-    stt += weight * (w->t_s - line.t_mean_s) * (w->t_s - line.t_mean_s);
-    sty += weight * (w->t_s - line.t_mean_s) * (w->estimate_s - line.value_s);
+    stt += weight(*w) * (w->t_s - line.t_mean_s) * (w->t_s - line.t_mean_s);
+    sty += weight(*w) * (w->t_s - line.t_mean_s) * (w->estimate_s - line.value_s);
   }
   if (!(stt > 0.0)) return std::nullopt;
   line.slope = sty / stt;
@@ -155,8 +155,9 @@ void ClockTracker::apply() {
   report_.windows.push_back(w);
   const double t_now_s = w.t_s + 0.5 * config_.track_window_s;
   drift_line_ = driftLine(t_now_s);
-  applied_s_ = drift_line_ ? drift_line_->value_s + drift_line_->slope * (t_now_s - drift_line_->t_mean_s)
-                           : w.estimate_s;
+  applied_s_ = drift_line_
+                   ? drift_line_->value_s + drift_line_->slope * (t_now_s - drift_line_->t_mean_s)
+                   : w.estimate_s;
   report_.windows.back().applied_s = applied_s_;
   set_offset_s_(applied_s_);
 }
@@ -186,9 +187,9 @@ ClockTrackingReport ClockTracker::finish() {
   }
   const std::size_t n = report_.windows.size();
   if (n == 0) {
-    report_.text = fmt::format(
-        "time offset held at {:.2f} ms: the run is shorter than one window of {:.0f} s",
-        1e3 * report_.offset_first_s, config_.track_window_s);
+    report_.text =
+        fmt::format("time offset held at {:.2f} ms: the run is shorter than one window of {:.0f} s",
+                    1e3 * report_.offset_first_s, config_.track_window_s);
   } else {
     report_.text = fmt::format(
         "time offset followed from {:.2f} to {:.2f} ms over {} windows of {:.0f} s ({} held: the "
@@ -196,9 +197,10 @@ ClockTrackingReport ClockTracker::finish() {
         1e3 * report_.offset_first_s, 1e3 * report_.offset_last_s, n, config_.track_window_s,
         report_.held);
     if (report_.drift_ppm)
-      report_.text += fmt::format("; the lidar clock drifts {:+.1f} ppm (1-sigma {:.1f}) against "
-                                  "the IMU's",
-                                  *report_.drift_ppm, *report_.drift_sigma_ppm);
+      report_.text += fmt::format(
+          "; the lidar clock drifts {:+.1f} ppm (1-sigma {:.1f}) against "
+          "the IMU's",
+          *report_.drift_ppm, *report_.drift_sigma_ppm);
   }
   return report_;
 }

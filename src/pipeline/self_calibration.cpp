@@ -24,7 +24,6 @@ struct PassData {
   std::size_t scans = 0;
 };
 
-
 /// The odometry over [from_s, to_s] of the recording (s after its first scan) with `rig`: the
 /// registrations' rotation increments between consecutive measured scans, and the gyro readings
 /// around them.

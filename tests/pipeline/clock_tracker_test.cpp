@@ -37,12 +37,17 @@ struct Tracked {
 Tracked track(const Rig& rig, double duration_s, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
-  auto noise3 = [&](double sigma) { return Vector3d(normal(rng), normal(rng), normal(rng)) * sigma; };
+  auto noise3 = [&](double sigma) {
+    return Vector3d(normal(rng), normal(rng), normal(rng)) * sigma;
+  };
   constexpr double kFine_s = 0.001;  // the true attitude on a 1 kHz grid of the IMU clock
   std::vector<lie::SO3> attitude{lie::SO3()};
   for (double t = 0.0; t < duration_s + 2.0; t += kFine_s)
-    attitude.push_back(attitude.back() * lie::SO3::Exp(trueRate(t + 0.5 * kFine_s, rig.turns) * kFine_s));
-  auto at = [&](double t_imu) { return attitude[static_cast<std::size_t>(std::lround(t_imu / kFine_s))]; };
+    attitude.push_back(attitude.back() *
+                       lie::SO3::Exp(trueRate(t + 0.5 * kFine_s, rig.turns) * kFine_s));
+  auto at = [&](double t_imu) {
+    return attitude[static_cast<std::size_t>(std::lround(t_imu / kFine_s))];
+  };
 
   CalibrationConfig config;
   RigConfig rig_config;
@@ -66,7 +71,8 @@ Tracked track(const Rig& rig, double duration_s, unsigned seed) {
     outcome.scan_index = index;
     outcome.t_s = scan.t_end_s;
     outcome.lidar = LidarFactor::kUsed;
-    outcome.registration.T_target_source = lie::SE3(at(t_true) * lie::SO3::Exp(noise3(3e-4)), Vector3d::Zero());
+    outcome.registration.T_target_source =
+        lie::SE3(at(t_true) * lie::SO3::Exp(noise3(3e-4)), Vector3d::Zero());
     tracker.onScan(outcome, lie::SE3());
     run.true_end_s = rig.offset_at_zero_s + rig.drift * t_lidar;
   }

@@ -396,7 +396,8 @@ TEST(OdometryScenario, ADriftingLidarClockIsFollowed) {
   const ScenarioRun tracked = simulateAndRun("handheld-loop", 90.0, 4, dir.path(), setup);
   RunSetup untracked_setup = setup;
   untracked_setup.track_offset = false;
-  const ScenarioRun untracked = simulateAndRun("handheld-loop", 90.0, 4, dir.path(), untracked_setup);
+  const ScenarioRun untracked =
+      simulateAndRun("handheld-loop", 90.0, 4, dir.path(), untracked_setup);
   expectEveryScanUsed(tracked.summary);
   ASSERT_TRUE(tracked.summary.clock);
   const ClockTrackingReport& clock = *tracked.summary.clock;

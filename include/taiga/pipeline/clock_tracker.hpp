@@ -7,8 +7,8 @@
 // last `track_window_s` of the run's own registrations and gyro readings, with the estimator of
 // `taiga calibrate` (calib/time_rotation.hpp, equation (1)), and applied: the latest window's
 // value, or, once three windows show a drift beyond 2 sigma, the drift line fitted through them,
-// which the offset then follows scan by scan until the next window. A window whose motion does not show the offset (held by the
-// estimator's observability test) changes nothing and is counted.
+// which the offset then follows scan by scan until the next window. A window whose motion does not
+// show the offset (held by the estimator's observability test) changes nothing and is counted.
 //
 // The estimate (about 0.2 s of CPU) runs on its own thread; its result applies from a fixed
 // number of scans after the one that started it (waiting for it there if need be), and the scans
@@ -34,19 +34,19 @@ namespace taiga::pipeline {
 
 /// One re-estimate of the offset.
 struct ClockWindow {
-  double t_s = 0.0;           ///< the window's middle (IMU clock)
-  double estimate_s = 0.0;    ///< the window's offset (rig.lidar_time_offset_s convention)
-  double sigma_s = 0.0;       ///< its 1-sigma (the estimator's)
-  bool observable = false;    ///< false: held, estimate_s is the offset in use
-  double applied_s = 0.0;     ///< the offset set for the scans read after this window
+  double t_s = 0.0;                  ///< the window's middle (IMU clock)
+  double estimate_s = 0.0;           ///< the window's offset (rig.lidar_time_offset_s convention)
+  double sigma_s = 0.0;              ///< its 1-sigma (the estimator's)
+  bool observable = false;           ///< false: held, estimate_s is the offset in use
+  double applied_s = 0.0;            ///< the offset set for the scans read after this window
   double rotation_change_deg = 0.0;  ///< the window's R_body_lidar against the run's (not applied)
   std::size_t increments = 0;
-  std::string failed;         ///< why the window gave no estimate; empty when it did
+  std::string failed;  ///< why the window gave no estimate; empty when it did
 };
 
 /// offset(t) = value_s + slope * (t - t_mean_s), t on the IMU clock.
 struct ClockLine {
-  double t_mean_s = 0.0, value_s = 0.0;  ///< the windows' weighted mean time and the line there
+  double t_mean_s = 0.0, value_s = 0.0;   ///< the windows' weighted mean time and the line there
   double slope = 0.0, slope_sigma = 0.0;  ///< s per s (1e-6: 1 ppm)
 };
 
@@ -86,7 +86,6 @@ class ClockTracker final : public SlamObserver {
   };
   struct Pending {
     std::uint64_t apply_at_scan = 0;
-    ClockWindow window;  // filled by the thread
     std::future<ClockWindow> result;
   };
   double offsetOf(std::uint64_t scan_index) const;
