@@ -408,10 +408,185 @@ TEST(OdometryScenario, ADriftingLidarClockIsFollowed) {
   ASSERT_TRUE(clock.drift_ppm);
   EXPECT_NEAR(*clock.drift_ppm, -200.0, std::max(20.0, 3.0 * *clock.drift_sigma_ppm)) << clock.text;
   EXPECT_FALSE(untracked.summary.clock);
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "trajectory_imu.tum"),
+            readFile(dir.path() / "rerun" / "trajectory_imu.tum"));
+  // The map, exported from the keyframe store at the end of the run, too.
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "map.las"),
+            readFile(dir.path() / "rerun" / "map.las"));
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "keyframes" / "poses.tum"),
+            readFile(dir.path() / "rerun" / "keyframes" / "poses.tum"));
+}
+
+// A 6-axis IMU (the Ouster's own) that starts moving: the tilt from the mean specific force is
+// 5.5 deg off, gravity alignment levels the world after 2 s, and the residual (about 1.4 deg at
+// the start) decays as the local map renews itself. The end-point drift (first poses aligned)
+// measures mostly that first-pose tilt: 7.7 cm APE and 2.5 % on this 15 s, 19 m walk. The
+// documented best effort of issue 6, bounded so that a regression shows.
+TEST(OdometryScenario, SixAxisImuStartingInMotionAndLidarOnlyStayWithinDecimetres) {
+  test::TempDir dir;
+  const ScenarioRun run = simulateAndRun("mixed", 15.0, 3, dir.path());
+  expectEveryScanUsed(run.summary);
+  EXPECT_GT(run.summary.path_length_m, 10.0);
+  EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.12);
+  EXPECT_LT(run.evaluation.drift.drift_percent, 3.5);
+
+  // The same scans in a bag without the IMU, with odometry.imu_use left at auto: the run must
+  // notice that no IMU reading comes and switch to lidar-only odometry (constant-velocity
+  // prediction and deskew). 4.8 cm APE here, with a jittery path (4.5 cm RPE per scan against
+  // 0.7 cm with the IMU): every scan is still registered, none rejected.
+  SystemConfig config;
+  io::readConfigYaml(dir.path() / "recording" / "rig.yaml", config);
+  {
+    io::Recording recording =
+        io::openRecording(dir.path() / "recording" / "recording.bag", config.recording, config.rig);
+    io::BagWriter scans_only(dir.path() / "scans_only.bag");
+    while (std::optional<io::RecordingEvent> event = recording.next()) {
+      if (const auto* scan = std::get_if<io::Scan>(&*event))
+        scans_only.writeScan(config.recording.lidar_topic, "os_sensor", *scan);
+    }
+  }
+  config.recording.imu_topic.clear();
+  config.recording.gnss_topic.clear();
+  ASSERT_EQ(config.odometry.imu_use, "auto");
+  const RunSummary lidar_only =
+      runOdometry(dir.path() / "scans_only.bag", config,
+                  {.out_dir = dir.path() / "lidar_only", .show_progress = false});
+  EXPECT_EQ(lidar_only.imu_samples, 0u);
+  EXPECT_EQ(lidar_only.scans_processed, lidar_only.scans);
+  EXPECT_EQ(lidar_only.lidar_rejected, 0u);
+  const eval::EvalResult lidar_only_eval =
+      eval::evaluate(io::readTum(dir.path() / "lidar_only" / "trajectory_odometry.tum"),
+                     io::readTum(dir.path() / "recording" / "groundtruth.tum"), {});
+  EXPECT_LT(lidar_only_eval.ape.translation_m.rmse, 0.10);
+  RecordProperty("lidar_only_ape_rmse_m", std::to_string(lidar_only_eval.ape.translation_m.rmse));
+}
+
+// The three-minute walk of issues 6 and 7. The odometry alone (issue 6, no loop closure) must
+// keep ATE <= 10 cm and end-point drift <= 0.5 % on this 207 m loop; a lidar factor whose
+// heading sigma is tighter than its tilt sigma took it from 16 to about 6.6 cm. The mapping graph
+// then closes the loop when the walker returns to the start: the end pose comes back to within
+// 5 cm of the start's true relative position, and the ATE drops below 5 cm (issue 7): the
+// 64-beam rig.yaml's 0.5 m NDT cells shrink the steps by 0.12 % instead of 0.21 % with 1 m cells
+// (docs/odometry.md, "Scale").
+TEST(OdometryScenario, HandheldLoopOfThreeMinutes) {
+  test::TempDir dir;
+  const ScenarioRun run = simulateAndRun("handheld-loop", 180.0, 2, dir.path());
+  expectEveryScanUsed(run.summary);
+  EXPECT_GT(run.summary.path_length_m, 150.0);
+  EXPECT_LT(run.odometry_evaluation.drift.drift_percent, 0.5);
+  EXPECT_LT(run.odometry_evaluation.ape.translation_m.rmse, 0.10);
+
+  EXPECT_GE(run.summary.loop_closures, 1u);
+  EXPECT_LT(run.evaluation.drift.drift_m, 0.05);
+  EXPECT_LT(run.evaluation.ape.translation_m.rmse, run.odometry_evaluation.ape.translation_m.rmse);
+  EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.05);  // issue 7's bound
+  EXPECT_LT(run.map_sharpness.rms_m, 0.04);
+  // The loop corrections reach the live odometry (mapping.correct_odometry): its published poses
+  // follow the graph's, so they beat the uncorrected odometry in RMSE (measured in session 48:
+  // 6.52 vs 6.64 cm, max 15.3 vs 17.6 cm), and where a loop bent the recent keyframes the local
+  // map was rebuilt (3 times). Since session 49 trajectory_odometry.tum is levelled at the end by
+  // the frame's tilt as finally estimated, which the live poses did not know yet: max 10.3 cm
+  // live against 10.1 cm. A correction applied the wrong way would double the error.
+  EXPECT_GE(run.summary.local_map_rebuilds, 1u);
+  EXPECT_LT(run.online_evaluation.ape.translation_m.rmse,
+            run.odometry_evaluation.ape.translation_m.rmse);
+  EXPECT_LT(run.online_evaluation.ape.translation_m.max,
+            1.1 * run.odometry_evaluation.ape.translation_m.max);
+  expectAFalseLoopIsRefused(dir.path() / "run_rig");
+}
+
+// Issue 6: no divergence and ATE <= 15 cm through vibration bursts and long stops. The crane's
+// per-scan boxes (machine_boxes.csv) and the cabin box (rig.self_boxes_body) keep the machine's
+// own returns out of registration.
+TEST(OdometryScenario, HarvesterOfThreeMinutes) {
+  test::TempDir dir;
+  const ScenarioRun run = simulateAndRun("harvester", 180.0, 2, dir.path(), {.crop_machine = true});
+  expectEveryScanUsed(run.summary);
+  EXPECT_LE(run.summary.lidar_inflated, run.summary.scans / 20);
+  EXPECT_LT(run.evaluation.ape.translation_m.rmse, 0.15);
+  EXPECT_LT(run.evaluation.ape.translation_m.max, 0.30);
+}
+
+// Issue 18: the rig as its user would write it. With `typical` realism the recording has IMU
+// noise 2x its datasheet, wandering biases, scale and axis errors, a 2 deg / 3 cm extrinsic
+// error, a 10 ms time offset, noisier and lossier lidar returns and wind; rig.yaml states the
+// nominal rig. Measured on these 15 s walks (64 beams): ATE 3.2, 3.5, 2.2 cm with rig.yaml (5.1,
+// 3.1, 2.6 cm before the odometry estimated its frame's tilt, session 49; 5.9, 3.9, 3.8 cm before
+// the levelling estimated the accelerometer bias, session 46), against
+// 0.5-1.7 cm ideal; told the truth (rig_truth.yaml) the same recordings give 0.9-1.8 cm. So the
+// estimator copes with the sensors' errors, and the rig's unstated extrinsics and time offset cost
+// the rest (bench/realism_sources.sh measures each source on its own; the self-calibration issue is
+// to remove it).
+TEST(OdometryScenario, TypicalRealismWithTheRigAUserWouldWriteOnThreeSeeds) {
+  for (const std::uint64_t seed : {1, 2, 3}) {
+    SCOPED_TRACE(seed);
+    test::TempDir dir;
+    const ScenarioRun stated =
+        simulateAndRun("handheld-loop", 15.0, seed, dir.path(), {.realism = "typical"});
+    expectEveryScanUsed(stated.summary);
+    EXPECT_LT(stated.evaluation.ape.translation_m.rmse, 0.10);
+    EXPECT_LT(stated.evaluation.drift.drift_percent, 4.0);
+    const ScenarioRun truth = simulateAndRun("handheld-loop", 15.0, seed, dir.path(),
+                                             {.realism = "typical", .rig_file = "rig_truth.yaml"});
+    expectEveryScanUsed(truth.summary);
+    EXPECT_LT(truth.evaluation.ape.translation_m.rmse, 0.03);
+    EXPECT_LT(truth.evaluation.ape.translation_m.rmse, stated.evaluation.ape.translation_m.rmse);
+    // Issue 20: the same rig.yaml, calibrated on the recording first. The time offset is found
+    // to within a millisecond (the truth: 10 ms at the start, drifting 10 ppm); the lever arm
+    // stays 3 cm off, which keeps the run above the true rig's. Measured ATE 2.9, 1.7, 1.9 cm:
+    // 0.91, 0.49, 0.86 of the stated rig's (0.68, 0.40, 0.67 before session 49: the stated rig
+    // gained more from the frame's tilt estimate than the calibrated one).
+    const ScenarioRun calibrated =
+        simulateAndRun("handheld-loop", 15.0, seed, dir.path(),
+                       {.realism = "typical", .calibrate_at_start = true});
+    expectEveryScanUsed(calibrated.summary);
+    ASSERT_TRUE(calibrated.summary.calibration);
+    const CalibrationRunReport& c = *calibrated.summary.calibration;
+    EXPECT_TRUE(c.skipped.empty()) << c.skipped;
+    EXPECT_TRUE(c.offset_observable);
+    EXPECT_NEAR(c.time_offset_s, 0.010, 0.001);
+    EXPECT_EQ(c.rotation_observable_axes, "xyz");
+    EXPECT_LT(calibrated.evaluation.ape.translation_m.rmse,
+              0.95 * stated.evaluation.ape.translation_m.rmse);
+    RecordProperty("ape_stated_calibrated_m_seed_" + std::to_string(seed),
+                   std::to_string(stated.evaluation.ape.translation_m.rmse) + " " +
+                       std::to_string(calibrated.evaluation.ape.translation_m.rmse));
+    EXPECT_LT(calibrated.evaluation.ape.translation_m.rmse, 0.04);  // measured 3.3 cm on seed 1
+  }
+}
+
+// A lidar clock that runs 200 ppm fast against the IMU's (18 ms over the 90 s; a free-running
+// oscillator at 10 ppm gets there in 30 min), the offset stated right at the start, the rest
+// ideal, 32 beams: the run follows the offset (calibration.track_offset,
+// pipeline/clock_tracker.hpp) and says the drift.
+TEST(OdometryScenario, ADriftingLidarClockIsFollowed) {
+  test::TempDir dir;
+  const RunSetup setup{.overrides = "rig: {lidar_clock_drift_ppm: 200}\n", .beams = 32};
+  const ScenarioRun tracked = simulateAndRun("handheld-loop", 90.0, 4, dir.path(), setup);
+  RunSetup untracked_setup = setup;
+  untracked_setup.track_offset = false;
+  const ScenarioRun untracked =
+      simulateAndRun("handheld-loop", 90.0, 4, dir.path(), untracked_setup);
+  expectEveryScanUsed(tracked.summary);
+  ASSERT_TRUE(tracked.summary.clock);
+  const ClockTrackingReport& clock = *tracked.summary.clock;
+  EXPECT_GE(clock.windows.size(), 3u);
+  EXPECT_EQ(clock.held, 0u);
+  // The offset falls by the drift: -200 ppm x 90 s = -18 ms at the end.
+  EXPECT_NEAR(clock.offset_last_s, -200e-6 * 90.0, 0.0015) << clock.text;
+  ASSERT_TRUE(clock.drift_ppm);
+  EXPECT_NEAR(*clock.drift_ppm, -200.0, std::max(20.0, 3.0 * *clock.drift_sigma_ppm)) << clock.text;
+  EXPECT_FALSE(untracked.summary.clock);
   // The estimates run on their own thread, yet apply at fixed scans: a second run is the same.
-  const std::string first = readFile(dir.path() / "run_rig" / "trajectory.tum");
-  simulateAndRun("handheld-loop", 90.0, 4, dir.path(), setup);
-  EXPECT_EQ(first, readFile(dir.path() / "run_rig" / "trajectory.tum"));
+  {
+    SystemConfig config;
+    io::readConfigYaml(dir.path() / "recording" / "rig.yaml", config);
+    config.calibration.at_start = false;
+    runOdometry(dir.path() / "recording" / "recording.bag", config,
+                {.out_dir = dir.path() / "rerun", .show_progress = false});
+  }
+  EXPECT_EQ(readFile(dir.path() / "run_rig" / "trajectory.tum"),
+            readFile(dir.path() / "rerun" / "trajectory.tum"));
   RecordProperty("odometry_ape_tracked_untracked_m",
                  std::to_string(tracked.odometry_evaluation.ape.translation_m.rmse) + " " +
                      std::to_string(untracked.odometry_evaluation.ape.translation_m.rmse));

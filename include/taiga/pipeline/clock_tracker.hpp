@@ -12,8 +12,8 @@
 //
 // The estimate (about 0.2 s of CPU) runs on its own thread; its result applies from a fixed
 // number of scans after the one that started it (waiting for it there if need be), and the scans
-// are shifted to it here rather than by the reader, whose read-ahead varies: the run's outputs do
-// not depend on the threads' timing.
+// are shifted to it here rather than by the reader, whose read-ahead varies: which scan gets which
+// offset does not depend on the threads' timing.
 
 #include <cstdint>
 #include <deque>
