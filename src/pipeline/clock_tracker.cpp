@@ -192,10 +192,10 @@ ClockTrackingReport ClockTracker::finish() {
                     1e3 * report_.offset_first_s, config_.track_window_s);
   } else {
     report_.text = fmt::format(
-        "time offset followed from {:.2f} to {:.2f} ms over {} windows of {:.0f} s ({} held: the "
-        "motion did not show it)",
+        "time offset followed from {:.2f} to {:.2f} ms over {} windows of {:.0f} s ({} held: "
+        "their motion did not show an offset within {:.0f} ms of the one in use)",
         1e3 * report_.offset_first_s, 1e3 * report_.offset_last_s, n, config_.track_window_s,
-        report_.held);
+        report_.held, 1e3 * kMaxOffsetChange_s);
     if (report_.drift_ppm)
       report_.text += fmt::format(
           "; the lidar clock drifts {:+.1f} ppm (1-sigma {:.1f}) against "

@@ -96,7 +96,7 @@ bool useLidarOnly(io::Recording& recording, const std::string& imu_use,
 /// Returns the scans read and, under --realtime, what a live run would have seen.
 std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEvent> read_ahead,
                           const RunOptions& options, const LiveConfig* live, SlamSystem& slam,
-                          ScanLog& scan_log, const HealthLog& health, ClockTracker* clock,
+                          ScanLog& scan_log, const HealthLog& health, ClockTracker* clock_tracker,
                           std::optional<RealtimeReport>& realtime) {
   Progress progress("taiga run", 0, "scans", stderr,
                     options.show_progress && isatty(fileno(stderr)));
@@ -106,7 +106,7 @@ std::size_t feedRecording(io::Recording& recording, std::deque<io::RecordingEven
     auto* scan = std::get_if<io::Scan>(&event);
     if (scan) scan_log.chargeReadTime(scan->index, std::exchange(read_ms_since_scan, 0.0));
     if (scan && scan->times_invented) scan_log.countMadeUpTimes();
-    if (scan && clock != nullptr) clock->adjust(*scan);
+    if (scan && clock_tracker != nullptr) clock_tracker->adjust(*scan);
     slam.add(event);
     if (scan) progress.update(++scans, health.progressNote());
     return scan != nullptr;
@@ -279,18 +279,19 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
         })
                      : nullptr));
 
-  std::optional<ClockTracker> clock;
+  std::optional<ClockTracker> clock_tracker;
   if (config.calibration.track_offset && !lidar_only) {
-    clock.emplace(config.calibration, config.rig,
-                  [&recording](double offset_s) { recording.setLidarTimeOffset(offset_s); });
-    slam.addObserver(*clock);
+    clock_tracker.emplace(config.calibration, config.rig, [&recording](double offset_s) {
+      recording.setLidarTimeOffset(offset_s);
+    });
+    slam.addObserver(*clock_tracker);
   }
 
   RunSummary summary;
   const auto wall_start = Clock::now();
   summary.scans = feedRecording(recording, std::move(read_ahead), options,
                                 live != nullptr ? &config.live : nullptr, slam, scan_log, health,
-                                clock ? &*clock : nullptr, summary.realtime);
+                                clock_tracker ? &*clock_tracker : nullptr, summary.realtime);
   if (live != nullptr) {
     live->setImuTap(nullptr);  // before pose_stream goes
     summary.live = live->stats();
@@ -314,8 +315,8 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
         "the odom frame was {:.2f} deg off level by the odometry's final estimate; the "
         "trajectories and the map are levelled by it",
         summary.frame_tilt_deg.norm());
-  if (clock) {
-    summary.clock = clock->finish();
+  if (clock_tracker) {
+    summary.clock = clock_tracker->finish();
     logger().info("clock: {}", summary.clock->text);
     writeClockWindows(out / "clock_offset.csv", summary.clock->windows);
   }

@@ -93,7 +93,6 @@ class Recording {
   /// already have read a few scans ahead with the previous one). The streams are merged in time
   /// order after it, so the scans come after the IMU readings that precede them.
   void setLidarTimeOffset(double offset_s) { lidar_time_offset_s_->store(offset_s); }
-  double lidarTimeOffset() const { return lidar_time_offset_s_->load(); }
 
  private:
   struct Stream;
