@@ -1,6 +1,31 @@
 #include "taiga/core/rig_config.hpp"
 
+#include <fmt/format.h>
+
+#include <array>
+
 namespace taiga {
+
+void GyroAxes::visit(ConfigVisitor& v) {
+  static constexpr std::array<std::string_view, 3> kAxes{"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d row = M_reading_true.row(i).transpose();
+    v.field(kAxes[i], row,
+            "the gyro's reading on this axis per rad/s about the IMU frame's x, y and z");
+    M_reading_true.row(i) = row.transpose();
+  }
+}
+
+void GyroAxes::validate() const {
+  // Beyond 20 % the matrix is not a MEMS gyro's error but a wrong unit or a swapped axis, which
+  // belongs in T_body_imu.
+  static constexpr std::array<std::string_view, 3> kAxes{"x", "y", "z"};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      requireInRange(fmt::format("{}[{}]", kAxes[r], c), M_reading_true(r, c),
+                     (r == c ? 1.0 : 0.0) - 0.2, (r == c ? 1.0 : 0.0) + 0.2,
+                     "(a scale or axis error beyond 20 % is a unit or axis mistake)");
+}
 
 void RigConfig::visit(ConfigVisitor& v) {
   v.field("T_body_lidar", T_body_lidar,
@@ -19,6 +44,9 @@ void RigConfig::visit(ConfigVisitor& v) {
   v.field("self_boxes_body", self_boxes_body,
           "boxes {min_m, max_m} in the body frame around the rig itself (operator, cabin); "
           "returns inside are dropped");
+  v.section("gyro_axes", gyro_axes,
+            "the gyro's scale and axis errors, rows x, y, z: reading = rows * true rate "
+            "(from a lab calibration, e.g. Kalibr's scale-misalignment model; identity: none)");
 }
 
 void RigConfig::validate() const {

@@ -42,6 +42,13 @@ Recording::Recording(std::string source, std::vector<std::unique_ptr<StreamSourc
   for (auto& s : streams) streams_.push_back(Stream{std::move(s), std::nullopt});
 }
 
+void Recording::setGyroAxes(const GyroAxes& axes) {
+  if (axes.isIdentity())
+    M_true_reading_.reset();
+  else
+    M_true_reading_ = axes.M_reading_true.inverse();
+}
+
 Recording::Recording(Recording&&) noexcept = default;
 Recording& Recording::operator=(Recording&&) noexcept = default;
 Recording::~Recording() = default;
@@ -70,6 +77,8 @@ void Recording::refill(Stream& stream) {
     }
     if (auto* scan = std::get_if<Scan>(&*event))
       shiftScanTimes(*scan, lidar_time_offset_s_->load());
+    else if (auto* imu = std::get_if<ImuSample>(&*event); imu && M_true_reading_)
+      imu->angular_velocity_imu_radps = *M_true_reading_ * imu->angular_velocity_imu_radps;
     const double t_s = eventTime(*event);
     if (t_s > stream.last_time_s) {
       stream.last_time_s = t_s;
@@ -162,7 +171,9 @@ Recording openRecording(const std::filesystem::path& path, const RecordingConfig
                                  "(.pcap) or a folder recording",
                                  path.string()));
   }
-  return Recording(path.string(), std::move(streams), rig.lidar_time_offset_s);
+  Recording opened(path.string(), std::move(streams), rig.lidar_time_offset_s);
+  opened.setGyroAxes(rig.gyro_axes);
+  return opened;
 }
 
 }  // namespace taiga::io

@@ -12,6 +12,7 @@
 #include "taiga/core/angles.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
+#include "taiga/sim/imu.hpp"
 #include "taiga/sim/random.hpp"
 
 namespace taiga::sim::detail {
@@ -22,7 +23,8 @@ std::string trueRigComment(const Scenario& s) {
   return fmt::format(
       "# Realism '{}': true IMU noise densities {}x and bias walks {}x the stated ones (below);\n"
       "#   Gauss-Markov biases {} m/s^2 and {} rad/s (1-sigma, {} s); scale errors {} and axis\n"
-      "#   misalignments {} deg (1-sigma); gyro g-sensitivity {} deg/s/g; clipping at {} g and {}\n"
+      "#   misalignments {} deg (1-sigma; the gyro's drawn ones are rig.gyro_axes below, the\n"
+      "#   accelerometer's are not in the rig); gyro g-sensitivity {} deg/s/g; clipping at {} g and {}\n"
       "#   deg/s (0: none); stamp jitter {} s; lidar clock drift {} ppm (the offset below holds at\n"
       "#   the start); extrinsic error {} deg and {} m; lidar: range noise at the limit {} m,\n"
       "#   dropouts {}, packet loss {}; wind sway {} m at 20 m.\n",
@@ -64,6 +66,9 @@ void writeRigYaml(const std::filesystem::path& path, const Simulation& simulatio
   config.rig.T_body_imu = lie::SE3();
   config.rig.lidar_time_offset_s = truth ? rig_error.lidar_time_offset_s : 0.0;
   config.rig.imu_acceleration_unit = AccelerationUnit::kMetersPerSecond2;
+  if (truth)
+    config.rig.gyro_axes.M_reading_true =
+        ImuSimulator(imu, simulation.seed(), simulation.scenario().gnss.world_yaw_deg).gyroAxes();
   config.recording.lidar_topic = kLidarTopic;
   const OutputParams& output = simulation.scenario().output;
   config.recording.imu_topic = output.imu ? kImuTopic : "";

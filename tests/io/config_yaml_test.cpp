@@ -86,6 +86,19 @@ TEST(ConfigYaml, ReadsRigExtrinsicsAsQuaternionOrRollPitchYaw) {
   EXPECT_EQ(config.rig.imu_acceleration_unit, AccelerationUnit::kStandardGravity);
 }
 
+TEST(ConfigYaml, ReadsTheGyrosScaleAndAxisErrorsAsRows) {
+  SystemConfig config;
+  EXPECT_TRUE(config.rig.gyro_axes.isIdentity());
+  readConfigYamlText("rig:\n  gyro_axes:\n    x: [1.01, 0.002, 0]\n    z: [0, -0.003, 0.99]\n",
+                     "rig.yaml", config);
+  Eigen::Matrix3d expected;
+  expected << 1.01, 0.002, 0, 0, 1, 0, 0, -0.003, 0.99;  // y keeps its default row
+  EXPECT_EQ(config.rig.gyro_axes.M_reading_true, expected);
+  SystemConfig copy;
+  readConfigYamlText(writeConfigYaml(config), "written.yaml", copy);
+  EXPECT_EQ(copy.rig.gyro_axes.M_reading_true, expected);
+}
+
 TEST(ConfigYaml, WrittenConfigReadsBackIdentically) {
   Everything original = read("voxel_m: 0.123456789012345\nname: 'true'\n");
   original.T_a_b =
@@ -184,6 +197,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"rig:\n  T_body_lidar:\n    translation_m: [0, 0, 150]\n",
                   "test.yaml:2:3: rig.T_body_lidar.translation_m: expected a value in [0, 10] m "
                   "(length), got 150"},
+        BadConfig{"rig:\n  gyro_axes:\n    y: [0, 1.5, 0]\n",
+                  "test.yaml: rig.gyro_axes.y[1]: expected a value in [0.8, 1.2] (a scale or "
+                  "axis error beyond 20 % is a unit or axis mistake), got 1.5"},
+        BadConfig{"rig:\n  gyro_axes:\n    z: [0, 1]\n",
+                  "rig.gyro_axes.z: expected"},
         // boxes
         BadConfig{"rig:\n  self_boxes_body: {min_m: [0, 0, 0]}\n",
                    "rig.self_boxes_body: expected a list of boxes"},

@@ -77,6 +77,22 @@ TEST(Recording, AppliesTheLidarClockOffsetToEveryScanTime) {
   EXPECT_FALSE(recording.next().has_value());  // the sample at 0.12 s came before the shifted scan
 }
 
+TEST(Recording, TakesTheGyrosScaleAndAxisErrorsOutOfItsReadings) {
+  GyroAxes axes;
+  axes.M_reading_true << 1.02, 0.01, 0.0, 0.0, 0.98, 0.0, 0.005, 0.0, 1.0;
+  const Eigen::Vector3d rate_radps(0.3, -1.2, 0.7);
+  ImuSample reading = imuAt(0.0);
+  reading.angular_velocity_imu_radps = axes.M_reading_true * rate_radps;
+  reading.acceleration_imu_mps2 = {0.1, 0.2, 9.8};
+  Recording recording = make({}, {reading});
+  recording.setGyroAxes(axes);
+  const std::optional<RecordingEvent> e = recording.next();
+  ASSERT_TRUE(e && std::holds_alternative<ImuSample>(*e));
+  const ImuSample& corrected = std::get<ImuSample>(*e);
+  EXPECT_TRUE(corrected.angular_velocity_imu_radps.isApprox(rate_radps, 1e-12));
+  EXPECT_EQ(corrected.acceleration_imu_mps2, reading.acceleration_imu_mps2);  // the gyro's only
+}
+
 TEST(Recording, DropsRepeatedOrSlightlyEarlierEventsAndCountsThem) {
   Recording recording = make({}, {imuAt(1.0), imuAt(1.0), imuAt(0.9), imuAt(1.1)});
   EXPECT_EQ(times(recording), (std::vector<double>{1.0, 1.1}));

@@ -102,6 +102,11 @@ TEST(Realism, RigYamlStatesTheNominalRigAndRigTruthTheTrueOne) {
   EXPECT_DOUBLE_EQ(stated.odometry.imu.accel_noise_density, s.imu.accel_noise_density);
   EXPECT_DOUBLE_EQ(truth.odometry.imu.accel_noise_density, 2.0 * s.imu.accel_noise_density);
   EXPECT_DOUBLE_EQ(truth.odometry.imu.gyro_bias_random_walk, 2.0 * s.imu.gyro_bias_random_walk);
+  // The gyro's drawn scale and axis errors are a key of the true rig; the user's rig has none.
+  EXPECT_TRUE(stated.rig.gyro_axes.isIdentity());
+  const Eigen::Matrix3d M_gyro = ImuSimulator(s.imu, simulation.seed()).gyroAxes();
+  EXPECT_GT((M_gyro - Eigen::Matrix3d::Identity()).norm(), 1e-3);  // 0.5 %, 0.3 deg (1-sigma)
+  EXPECT_TRUE(truth.rig.gyro_axes.M_reading_true.isApprox(M_gyro, 1e-12));
 
   // The lidar stamps are late on the IMU clock by the offset, plus the clock's drift: with the
   // truth's rig.lidar_time_offset_s the scans start at k * 0.1 s of motion time again.

@@ -68,7 +68,8 @@ struct RecordingRepairs {
 /// Within a stream, an event whose time is not after the previous one is dropped with a warning
 /// (drivers occasionally repeat a stamp); a stream that jumps back by more than
 /// kMaxBackwardJump_s is an error, because the recording then mixes clocks. The lidar clock
-/// offset is added to every scan time before merging.
+/// offset is added to every scan time before merging, and the gyro's scale and axis errors are
+/// taken out of every IMU reading.
 class Recording {
  public:
   static constexpr double kMaxBackwardJump_s = 1.0;
@@ -93,6 +94,9 @@ class Recording {
   /// already have read a few scans ahead with the previous one). The streams are merged in time
   /// order after it, so the scans come after the IMU readings that precede them.
   void setLidarTimeOffset(double offset_s) { lidar_time_offset_s_->store(offset_s); }
+  /// The gyro readings read from now on are corrected for the gyro's scale and axis errors
+  /// (rig.gyro_axes): rate = M_reading_true^-1 * reading. openRecording sets the rig's.
+  void setGyroAxes(const GyroAxes& axes);
 
  private:
   struct Stream;
@@ -102,6 +106,7 @@ class Recording {
   std::vector<Stream> streams_;
   std::unique_ptr<std::atomic<double>> lidar_time_offset_s_;  // movable, unlike the atomic
   RecordingRepairs repairs_;
+  std::optional<Eigen::Matrix3d> M_true_reading_;  // unset: the readings as they are
 };
 
 /// Opens a ROS1 bag (*.bag), an Ouster capture (*.pcap with its metadata JSON) or a folder

@@ -49,6 +49,9 @@ class ImuSimulator {
   /// before the first); the Gauss-Markov part is markovBiases().
   const ImuBiases& biases() const { return biases_; }
   const ImuBiases& markovBiases() const { return markov_; }
+  /// The gyro's scale and axis errors, drawn from the seed: reading = this * true rate (+ bias,
+  /// g-sensitivity, noise). rig_truth.yaml's rig.gyro_axes.
+  const Eigen::Matrix3d& gyroAxes() const { return M_gyro_; }
   /// Errors of the orientation given with the last sample: tilt about east and north, heading
   /// about up, rad (zero when the output is off or noise is false).
   Eigen::Vector3d orientationError_rad() const {
