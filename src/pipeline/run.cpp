@@ -268,11 +268,12 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     slam.addObserver(
         pose_stream.emplace(config.live.pose_udp, foxglove.get(), config, live == nullptr));
     if (live != nullptr)
-      live->setImuTap([&pose_stream, M_true_reading = config.rig.gyro_axes.M_reading_true.inverse()](
-                          ImuSample sample) {  // as the Recording corrects them
-        sample.angular_velocity_imu_radps = M_true_reading * sample.angular_velocity_imu_radps;
-        pose_stream->imuArrived(sample);
-      });
+      live->setImuTap(
+          [&pose_stream, M_true_reading = config.rig.gyro_axes.M_reading_true.inverse()](
+              ImuSample sample) {  // as the Recording corrects them
+            sample.angular_velocity_imu_radps = M_true_reading * sample.angular_velocity_imu_radps;
+            pose_stream->imuArrived(sample);
+          });
   }
   std::optional<OnlineTrees> online_trees;
   if (config.mapping.trees)

@@ -24,10 +24,10 @@ std::string trueRigComment(const Scenario& s) {
       "# Realism '{}': true IMU noise densities {}x and bias walks {}x the stated ones (below);\n"
       "#   Gauss-Markov biases {} m/s^2 and {} rad/s (1-sigma, {} s); scale errors {} and axis\n"
       "#   misalignments {} deg (1-sigma; the gyro's drawn ones are rig.gyro_axes below, the\n"
-      "#   accelerometer's are not in the rig); gyro g-sensitivity {} deg/s/g; clipping at {} g and {}\n"
-      "#   deg/s (0: none); stamp jitter {} s; lidar clock drift {} ppm (the offset below holds at\n"
-      "#   the start); extrinsic error {} deg and {} m; lidar: range noise at the limit {} m,\n"
-      "#   dropouts {}, packet loss {}; wind sway {} m at 20 m.\n",
+      "#   accelerometer's are not in the rig); gyro g-sensitivity {} deg/s/g; clipping at {} g\n"
+      "#   and {} deg/s (0: none); stamp jitter {} s; lidar clock drift {} ppm (the offset below\n"
+      "#   holds at the start); extrinsic error {} deg and {} m; lidar: range noise at the limit\n"
+      "#   {} m, dropouts {}, packet loss {}; wind sway {} m at 20 m.\n",
       s.realism, imu.noise_density_factor, imu.bias_walk_factor, imu.accel_bias_instability_mps2,
       imu.gyro_bias_instability_radps, imu.bias_correlation_s, imu.scale_factor_error,
       imu.misalignment_deg, imu.gyro_g_sensitivity_deg_s_per_g, imu.accel_range_g,
