@@ -5,9 +5,11 @@
 #include <array>
 
 namespace taiga {
+namespace {
+constexpr std::array<std::string_view, 3> kAxes{"x", "y", "z"};  // GyroAxes' rows
+}  // namespace
 
 void GyroAxes::visit(ConfigVisitor& v) {
-  static constexpr std::array<std::string_view, 3> kAxes{"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
     Eigen::Vector3d row = M_reading_true.row(i).transpose();
     v.field(kAxes[i], row,
@@ -19,7 +21,6 @@ void GyroAxes::visit(ConfigVisitor& v) {
 void GyroAxes::validate() const {
   // Beyond 20 % the matrix is not a MEMS gyro's error but a wrong unit or a swapped axis, which
   // belongs in T_body_imu.
-  static constexpr std::array<std::string_view, 3> kAxes{"x", "y", "z"};
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
       requireInRange(fmt::format("{}[{}]", kAxes[r], c), M_reading_true(r, c),

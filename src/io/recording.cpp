@@ -77,8 +77,8 @@ void Recording::refill(Stream& stream) {
     }
     if (auto* scan = std::get_if<Scan>(&*event))
       shiftScanTimes(*scan, lidar_time_offset_s_->load());
-    else if (auto* imu = std::get_if<ImuSample>(&*event); imu && M_true_reading_)
-      imu->angular_velocity_imu_radps = *M_true_reading_ * imu->angular_velocity_imu_radps;
+    else if (auto* imu = std::get_if<ImuSample>(&*event))
+      correctGyro(*imu);
     const double t_s = eventTime(*event);
     if (t_s > stream.last_time_s) {
       stream.last_time_s = t_s;

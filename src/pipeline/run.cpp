@@ -268,12 +268,10 @@ RunSummary runRecording(io::Recording& recording, const std::filesystem::path& r
     slam.addObserver(
         pose_stream.emplace(config.live.pose_udp, foxglove.get(), config, live == nullptr));
     if (live != nullptr)
-      live->setImuTap(
-          [&pose_stream, M_true_reading = config.rig.gyro_axes.M_reading_true.inverse()](
-              ImuSample sample) {  // as the Recording corrects them
-            sample.angular_velocity_imu_radps = M_true_reading * sample.angular_velocity_imu_radps;
-            pose_stream->imuArrived(sample);
-          });
+      live->setImuTap([&pose_stream, &recording](ImuSample sample) {
+        recording.correctGyro(sample);
+        pose_stream->imuArrived(sample);
+      });
   }
   std::optional<OnlineTrees> online_trees;
   if (config.mapping.trees)
@@ -421,8 +419,7 @@ RunSummary runLive(const SystemConfig& config, const RunOptions& options) {
         .skipped =
             "not on a live sensor: calibrate a recording of the rig with taiga calibrate "
             "and give the run its rig.yaml"};
-  io::Recording recording = capture.recording(config.rig.lidar_time_offset_s);
-  recording.setGyroAxes(config.rig.gyro_axes);
+  io::Recording recording = capture.recording(config.rig);
   return runRecording(recording, capture.name(), config, std::nullopt, calibration, options,
                       &capture);
 }

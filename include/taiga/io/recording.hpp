@@ -97,6 +97,12 @@ class Recording {
   /// The gyro readings read from now on are corrected for the gyro's scale and axis errors
   /// (rig.gyro_axes): rate = M_reading_true^-1 * reading. openRecording sets the rig's.
   void setGyroAxes(const GyroAxes& axes);
+  /// Takes the gyro's scale and axis errors out of `sample` as next() does (for samples that
+  /// reach a reader before the recording delivers them, like a live sensor's IMU tap).
+  void correctGyro(ImuSample& sample) const {
+    if (M_true_reading_)
+      sample.angular_velocity_imu_radps = *M_true_reading_ * sample.angular_velocity_imu_radps;
+  }
 
  private:
   struct Stream;

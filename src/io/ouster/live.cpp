@@ -238,7 +238,7 @@ LiveCapture::~LiveCapture() {
 const SensorInfo& LiveCapture::info() const { return state_->info; }
 const std::string& LiveCapture::name() const { return state_->name; }
 
-Recording LiveCapture::recording(double lidar_time_offset_s) {
+Recording LiveCapture::recording(const RigConfig& rig) {
   const State& s = *state_;
   std::vector<std::unique_ptr<StreamSource>> streams;
   if (s.lidar_bytes > 0)
@@ -250,7 +250,9 @@ Recording LiveCapture::recording(double lidar_time_offset_s) {
     streams.push_back(std::make_unique<OusterImuSource>(
         fmt::format("{} (IMU)", s.name), std::make_unique<QueuedDatagrams>(state_, kImu), s.info,
         s.options.decoder));
-  return Recording(s.name, std::move(streams), lidar_time_offset_s);
+  Recording recording(s.name, std::move(streams), rig.lidar_time_offset_s);
+  recording.setGyroAxes(rig.gyro_axes);
+  return recording;
 }
 
 void LiveCapture::setImuTap(std::function<void(const ImuSample&)> tap) {

@@ -83,7 +83,7 @@ TEST(OusterLive, PacketsFromTheSocketsBecomeScansAndSamplesAndLossesAreCounted) 
   const auto metadata = dir.write("sensor.json", sensorInfoJson(info));
   LiveCapture capture(
       {.metadata = metadata, .bind_address = "127.0.0.1", .idle_timeout_s = 0.5});
-  Recording recording = capture.recording(0.0);
+  Recording recording = capture.recording(RigConfig{});
   std::thread sender([&] {
     UdpSocket lidar = UdpSocket::connected("127.0.0.1", info.udp_port_lidar);
     UdpSocket imu = UdpSocket::connected("127.0.0.1", info.udp_port_imu);
@@ -146,7 +146,7 @@ TEST(OusterLive, AStopRequestEndsTheStreams) {
   const auto metadata = dir.write("sensor.json", sensorInfoJson(info));
   LiveCapture capture(
       {.metadata = metadata, .bind_address = "127.0.0.1", .idle_timeout_s = 0.0});
-  Recording recording = capture.recording(0.0);
+  Recording recording = capture.recording(RigConfig{});
   std::thread stopper([] {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     requestLiveStop();

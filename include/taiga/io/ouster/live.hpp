@@ -71,9 +71,9 @@ class LiveCapture {
   const SensorInfo& info() const;
   /// "udp://0.0.0.0:7502+7503", for messages and summaries.
   const std::string& name() const;
-  /// The sensor's streams as a recording (call once); the lidar clock offset as in
-  /// openRecording. The recording may outlive this object: its streams then end.
-  Recording recording(double lidar_time_offset_s);
+  /// The sensor's streams as a recording (call once), with the rig's lidar clock offset and gyro
+  /// axes as in openRecording. The recording may outlive this object: its streams then end.
+  Recording recording(const RigConfig& rig);
   LiveStats stats() const;
   /// `tap` gets every IMU sample (IMU frame) as its packet arrives, on the receiver thread,
   /// before the recording delivers it in time order: for poses at IMU rate without waiting for
