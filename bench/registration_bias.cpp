@@ -12,7 +12,9 @@
 // SIM is a `taiga simulate` output directory. Keyframes every metre, source points in 0.4 m
 // voxels and map points in 0.2 m voxels per keyframe, as the odometry's defaults.
 #include <CLI/CLI.hpp>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -65,6 +67,7 @@ struct Options {
   std::string source_sample = "centroid", map_sample = "centroid";
   double source_noise_m = 0.0, map_noise_m = 0.0;  ///< added 1-sigma range noise (diagnosis)
   bool reverse = false;  ///< also register the map (as source) to the scan (as target)
+  bool stem_cells = false;  ///< NdtConfig::stem_cells
 };
 
 struct TrueScan {
@@ -146,15 +149,17 @@ registration::RegistrationResult align(const Options& o, std::span<const Eigen::
                                        const lie::SE3& guess) {
   registration::NdtConfig ndt;
   ndt.resolution_m = o.resolution_m;
+  ndt.stem_cells = o.stem_cells;
   if (o.method == "gicp") return registration::alignGicp(source, map_in_world, guess, {});
   lie::SE3 start = guess;
   if (o.coarse_resolution_m > 0.0) {
     start = registration::alignNdt(
-                source, registration::NdtTarget::fromPoints(map_in_world, o.coarse_resolution_m),
+                source,
+                registration::NdtTarget::fromPoints(map_in_world, o.coarse_resolution_m, ndt),
                 guess, ndt)
                 .T_target_source;
   }
-  const auto target = registration::NdtTarget::fromPoints(map_in_world, o.resolution_m);
+  const auto target = registration::NdtTarget::fromPoints(map_in_world, o.resolution_m, ndt);
   return o.method == "d2d" ? registration::alignD2dNdt(source, target, start, ndt)
                            : registration::alignNdt(source, target, start, ndt);
 }
@@ -237,6 +242,85 @@ void measureBias(const Options& o, const std::vector<TrueScan>& scans) {
                 1e3 * mean(reverse_along_m));
 }
 
+/// Where the bias comes from: each scan's NDT gradient at its true pose, split by the kind of
+/// surface each source point is scored against (its cell's normal: ground-like, upright or
+/// other) and by range, mapped through the whole scan's Hessian to the pose error each class
+/// alone would cause (delta = -H^-1 g, body frame, then along travel). The classes add up to the
+/// one-Newton-step error from the truth.
+void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
+  std::vector<std::size_t> keyframes{0};
+  for (std::size_t i = 1; i < scans.size(); ++i) {
+    const Eigen::Vector3d last = scans[keyframes.back()].T_world_body.translation();
+    if ((scans[i].T_world_body.translation() - last).norm() >= 1.0) keyframes.push_back(i);
+  }
+  const char* kClasses[] = {"ground (|n_z| > 0.8)", "upright (|n_z| < 0.3)", "other",
+                            "range < 5 m", "range 5-10 m", "range 10-20 m", "range > 20 m",
+                            "in stem cells"};
+  constexpr int kNumClasses = 8;
+  std::vector<double> along_m[kNumClasses], up_m[kNumClasses], total_along_m, total_up_m;
+  registration::NdtConfig ndt;
+  ndt.resolution_m = o.resolution_m;
+  ndt.stem_cells = o.stem_cells;
+  std::size_t num_points = 0, num_upright = 0, num_stem = 0;
+  for (std::size_t i = 1; i + 1 < scans.size(); i += o.every) {
+    std::vector<std::size_t> chosen;
+    for (std::size_t k : keyframes)
+      if (k < i) chosen.push_back(k);
+    if (chosen.size() < static_cast<std::size_t>(o.num_keyframes)) continue;
+    chosen.erase(chosen.begin(), chosen.end() - o.num_keyframes);
+    std::vector<lie::SE3> T_world_keyframe;
+    for (std::size_t k : chosen) T_world_keyframe.push_back(scans[k].T_world_body);
+    const TrueScan& scan = scans[i];
+    const Eigen::Vector3d forward = forwardOf(scans, i);
+    if (forward.isZero()) continue;
+    const auto target = registration::NdtTarget::fromPoints(
+        mapInWorld(scans, chosen, T_world_keyframe, scan.T_world_body.translation(), 180.0),
+        o.resolution_m, ndt);
+    std::vector<Eigen::Vector3d> by_class[kNumClasses];
+    for (const Eigen::Vector3d& p : scan.source_in_body) {
+      const registration::NdtCell* cells[7];
+      const Eigen::Vector3d q = scan.T_world_body * p;
+      if (target.neighbours(q, registration::NeighbourSearch::kDirect1, cells) == 0) continue;
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cells[0]->covariance);
+      const double n_z = std::abs(solver.eigenvectors().col(0).z());
+      by_class[n_z > 0.8 ? 0 : n_z < 0.3 ? 1 : 2].push_back(p);
+      const double r = p.norm();
+      by_class[r < 5 ? 3 : r < 10 ? 4 : r < 20 ? 5 : 6].push_back(p);
+      if (cells[0]->stem) by_class[7].push_back(p);
+      ++num_points;
+      if (n_z < 0.3) ++num_upright;
+      if (cells[0]->stem) ++num_stem;
+    }
+    const auto all = registration::ndtDerivatives(scan.source_in_body, target, scan.T_world_body,
+                                                  ndt, true, nullptr);
+    const Eigen::FullPivLU<lie::Matrix6> lu(all.hessian);
+    const Eigen::Matrix3d R = scan.T_world_body.rotation().matrix();
+    const auto errorOf = [&](const lie::Vector6& g) {
+      const lie::Vector6 delta = -lu.solve(g);
+      return Eigen::Vector3d(R * delta.head<3>());
+    };
+    const Eigen::Vector3d total = errorOf(all.gradient);
+    total_along_m.push_back(total.dot(forward));
+    total_up_m.push_back(total.z());
+    for (int c = 0; c < kNumClasses; ++c) {
+      const auto part = registration::ndtDerivatives(by_class[c], target, scan.T_world_body, ndt,
+                                                     false, nullptr);
+      const Eigen::Vector3d e = errorOf(part.gradient);
+      along_m[c].push_back(e.dot(forward));
+      up_m[c].push_back(e.z());
+    }
+  }
+  std::printf("%zu scans, %.2f m cells, one Newton step from the truth: along travel %+.3f mm, "
+              "up %+.3f mm\n",
+              total_along_m.size(), o.resolution_m, 1e3 * mean(total_along_m),
+              1e3 * mean(total_up_m));
+  for (int c = 0; c < kNumClasses; ++c)
+    std::printf("  %-22s along %+.3f mm, up %+.3f mm\n", kClasses[c], 1e3 * mean(along_m[c]),
+                1e3 * mean(up_m[c]));
+  std::printf("  %zu source points in cells, %zu in upright ones, %zu in stem cells\n",
+              num_points, num_upright, num_stem);
+}
+
 /// A lidar-only odometry with exact deskew: prediction from the true relative motion, a map of
 /// the last num_keyframes keyframes at their estimated poses. Its Sim(3) scale against the truth.
 void runOdometry(const Options& o, const std::vector<TrueScan>& scans) {
@@ -312,9 +396,10 @@ void checkAgainstScene(const Options& o, const std::vector<TrueScan>& scans,
 int main(int argc, char** argv) {
   CLI::App app{"Bias of scan-to-map registration on a simulated recording with exact deskew"};
   Options o;
-  bool odometry = false, scene_check = false;
+  bool odometry = false, scene_check = false, forces = false;
   app.add_option("sim", o.sim_dir, "taiga simulate output directory")->required();
   app.add_flag("--odometry", odometry, "run a lidar-only odometry and report its scale");
+  app.add_flag("--forces", forces, "split the bias by surface and range (NDT gradient)");
   app.add_flag("--scene-check", scene_check, "check the data against the regenerated scene");
   app.add_option("--method", o.method, "ndt | d2d | gicp");
   app.add_option("--resolution", o.resolution_m, "NDT cell edge, m");
@@ -338,6 +423,7 @@ int main(int argc, char** argv) {
   app.add_option("--map-sample", o.map_sample, "centroid | measured | raw (0.2 m voxels)");
   app.add_option("--source-noise", o.source_noise_m, "add range noise to the source, 1-sigma m");
   app.add_option("--map-noise", o.map_noise_m, "add range noise to the map points, 1-sigma m");
+  app.add_flag("--stem-cells", o.stem_cells, "NDT stem cells (ndt.hpp)");
   app.add_flag("--reverse", o.reverse, "also register the map to the scan (bias)");
   CLI11_PARSE(app, argc, argv);
   if (o.every < 1 || o.num_keyframes < 1 || o.skip_keyframes < 0) {
@@ -355,6 +441,7 @@ int main(int argc, char** argv) {
   }
   if (scene_check) checkAgainstScene(o, scans, truth);
   if (odometry) runOdometry(o, scans);
+  else if (forces) measureForces(o, scans);
   else measureBias(o, scans);
   return 0;
 }

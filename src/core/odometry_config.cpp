@@ -102,6 +102,9 @@ void OdometryConfig::visit(ConfigVisitor& v) {
   v.choice("ndt_neighbours", ndt_neighbours, kNeighbours,
            "NDT cells each scan point is scored against: its own (direct1) or also the six face "
            "neighbours (direct7)");
+  v.field("ndt_stem_cells", ndt_stem_cells,
+          "true: NDT cells holding a stem's section score points by their distance to its "
+          "circle, the same from every side (less shrink; docs/registration.md, Bias)");
   v.field("local_map_voxel_m", local_map_voxel_m, "m, spacing of keyframe points in the local map");
   v.field("local_map_keyframes", local_map_keyframes, "keyframes held in the local map");
   v.field("lidar_sigma", lidar_sigma,

@@ -26,7 +26,8 @@ void LocalMap::setNdtResolutions(const std::vector<double>& ndt_resolutions_m) {
   ndt_statistics_.clear();
   // Only the NDT target needs cells; GICP uses the points.
   if (target_ == Target::kNdt)
-    for (double resolution_m : ndt_resolutions_m) ndt_statistics_.emplace_back(resolution_m);
+    for (double resolution_m : ndt_resolutions_m)
+      ndt_statistics_.emplace_back(resolution_m, ndt_cells_.stem_cells);
 }
 
 LocalMap::~LocalMap() {

@@ -77,6 +77,28 @@ inline void accumulate(const Eigen::Vector3d& p, const Eigen::Vector3d& mu,
   }
 }
 
+// A stem cell's term (ndt.hpp, "Stem cells"): the Gaussian at the circle's point nearest p, with
+// the radial and vertical inverse variances. Its gradient is exact (d|p - c|/dp = n); the
+// Hessian leaves out the circle's curvature, as point-to-plane ICP leaves out a surface's.
+inline void accumulateStem(const Eigen::Vector3d& p, const NdtCell& cell, const NdtConstants& k,
+                           bool with_hessian, Partial& out) {
+  const Eigen::Vector2d d = p.head<2>() - cell.stem_centre;
+  const double rho = d.norm();
+  if (!(rho > 1e-6)) return;
+  const Eigen::Vector3d n(d.x() / rho, d.y() / rho, 0.0);
+  const Eigen::Vector3d mu(cell.stem_centre.x() + cell.stem_radius_m * n.x(),
+                           cell.stem_centre.y() + cell.stem_radius_m * n.y(), cell.mean.z());
+  Eigen::Matrix3d B = cell.inverse_radial_variance * n * n.transpose();
+  B(2, 2) = cell.inverse_vertical_variance;
+  accumulate(p, mu, B, k, with_hessian, out);
+}
+
+inline void accumulateCell(const Eigen::Vector3d& p, const NdtCell& cell, const NdtConstants& k,
+                           bool with_hessian, Partial& out) {
+  if (cell.stem) accumulateStem(p, cell, k, with_hessian, out);
+  else accumulate(p, cell.mean, cell.inverse_covariance, k, with_hessian, out);
+}
+
 template <class Body>
 NdtDerivatives reduce(std::size_t n, const lie::SE3& T_target_source, const Body& body) {
   const Partial total = detail::reduceInBlocks<Partial>(n, body, [](Partial& a, const Partial& b) {
@@ -130,7 +152,7 @@ NdtDerivatives ndtDerivatives(std::span<const Eigen::Vector3d> source, const Ndt
     if (n == 0) return;
     ++out.num_inliers;
     for (int c = 0; c < n; ++c) {
-      accumulate(p, cells[c]->mean, cells[c]->inverse_covariance, k, with_hessian, out);
+      accumulateCell(p, *cells[c], k, with_hessian, out);
     }
   });
 }

@@ -49,6 +49,9 @@ NdtConstants ndtConstants(double resolution_m, double outlier_ratio) {
 
 NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
     : resolution_m_(stats.resolution_m()), inverse_resolution_(1.0 / stats.resolution_m()) {
+  if (cells.stem_cells && !stats.circleMoments()) {
+    throw std::logic_error("NdtTarget: stem cells need statistics with circle moments");
+  }
   for (const CellMoments& m : stats.moments(cells.min_points_per_cell)) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(m.covariance);
     Eigen::Vector3d lambda = solver.eigenvalues();
@@ -66,6 +69,9 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
     cell.count = m.count;
     cell.covariance = V * lambda.asDiagonal() * V.transpose();
     cell.inverse_covariance = V * lambda.cwiseInverse().asDiagonal() * V.transpose();
+    if (cells.stem_cells) {
+      fitStemSection(m, resolution_m_, cells.min_eigenvalue_ratio * lambda_max, cell);
+    }
     cells_.push_back(cell);
     keys_.push_back(m.key);
   }
@@ -74,7 +80,7 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
 
 NdtTarget NdtTarget::fromPoints(std::span<const Eigen::Vector3d> points, double resolution_m,
                                 const NdtConfig& cells) {
-  VoxelStatistics stats(resolution_m);
+  VoxelStatistics stats(resolution_m, cells.stem_cells);
   stats.add(points);
   return NdtTarget(stats, cells);
 }

@@ -32,6 +32,7 @@ RegistrationConfig registrationConfigFor(const OdometryConfig& odometry) {
   config.ndt.coarse_resolutions_m.assign(resolutions_m.begin(), resolutions_m.end() - 1);
   config.ndt.search =
       odometry.ndt_neighbours == "direct1" ? NeighbourSearch::kDirect1 : NeighbourSearch::kDirect7;
+  config.ndt.stem_cells = odometry.ndt_stem_cells;
   return config;
 }
 

@@ -27,8 +27,10 @@ bool VoxelStatistics::Sums::operator==(const Sums& o) const {
   return count == o.count && std::equal(s, s + 3, o.s) && std::equal(ss, ss + 6, o.ss);
 }
 
-VoxelStatistics::VoxelStatistics(double resolution_m)
-    : resolution_m_(resolution_m), inverse_resolution_(1.0 / resolution_m) {
+VoxelStatistics::VoxelStatistics(double resolution_m, bool circle_moments)
+    : resolution_m_(resolution_m),
+      inverse_resolution_(1.0 / resolution_m),
+      circle_moments_(circle_moments) {
   if (!(resolution_m > 0.0) || !std::isfinite(resolution_m)) {
     throw std::invalid_argument("VoxelStatistics: resolution_m must be positive, got " +
                                 std::to_string(resolution_m));
@@ -61,6 +63,15 @@ void VoxelStatistics::update(const Eigen::Vector3d& p, int sign) {
   sums.ss[3] += sign * q[1] * q[1];
   sums.ss[4] += sign * q[1] * q[2];
   sums.ss[5] += sign * q[2] * q[2];
+  if (circle_moments_) {
+    // 128 bits: w^2 of one point in a 1 m cell is up to 2.5e19 quanta^4.
+    CircleSums& circle = circle_cells_[key];
+    const Int128 w = q[0] * q[0] + q[1] * q[1];
+    circle.xw += sign * (q[0] * w);
+    circle.yw += sign * (q[1] * w);
+    circle.ww += sign * (w * w);
+    if (sums.count == 0) circle_cells_.erase(key);
+  }
   if (sums.count == 0) cells_.erase(it);
 }
 
@@ -102,8 +113,34 @@ CellMoments VoxelStatistics::momentsOf(VoxelKey key, const Sums& sums) const {
         static_cast<double>(sums.ss[2]), static_cast<double>(sums.ss[4]),
         static_cast<double>(sums.ss[5]);
     m.covariance = (ss - s * s.transpose() / n) * (kQuantum_m * kQuantum_m / (n - 1.0));
+    if (circle_moments_) circleMoments(sums, circle_cells_.at(key), m);
   }
   return m;
+}
+
+void VoxelStatistics::circleMoments(const Sums& sums, const CircleSums& circle,
+                                    CellMoments& m) {
+  // Raw moments about the cell centre in quanta, then central ones: with
+  // a, b the mean, c = a^2 + b^2 and w' = w - 2 a x - 2 b y + c,
+  //   E[x' w'] = E[x w] - a E[w] - 2 a E[x^2] - 2 b E[x y] + 2 a c           (and y alike)
+  //   E[w'^2]  = E[w^2] + 4 (a^2 E[x^2] + b^2 E[y^2] + 2 a b E[x y]) - 4 (a E[x w] + b E[y w])
+  //              + 2 c E[w] - 3 c^2.
+  const double n = static_cast<double>(sums.count);
+  const double a = static_cast<double>(sums.s[0]) / n;
+  const double b = static_cast<double>(sums.s[1]) / n;
+  const double xx = static_cast<double>(sums.ss[0]) / n;
+  const double xy = static_cast<double>(sums.ss[1]) / n;
+  const double yy = static_cast<double>(sums.ss[3]) / n;
+  const double xw = static_cast<double>(circle.xw) / n;
+  const double yw = static_cast<double>(circle.yw) / n;
+  const double ww = static_cast<double>(circle.ww) / n;
+  const double w = xx + yy, c = a * a + b * b;
+  constexpr double kM3 = kQuantum_m * kQuantum_m * kQuantum_m, kM4 = kM3 * kQuantum_m;
+  m.xw = (xw - a * w - 2.0 * a * xx - 2.0 * b * xy + 2.0 * a * c) * kM3;
+  m.yw = (yw - b * w - 2.0 * b * yy - 2.0 * a * xy + 2.0 * b * c) * kM3;
+  m.ww = (ww + 4.0 * (a * a * xx + b * b * yy + 2.0 * a * b * xy) - 4.0 * (a * xw + b * yw) +
+          2.0 * c * w - 3.0 * c * c) *
+         kM4;
 }
 
 std::vector<CellMoments> VoxelStatistics::moments(std::size_t min_points) const {
@@ -132,7 +169,8 @@ std::vector<Eigen::Vector3d> VoxelStatistics::means() const {
 }
 
 bool VoxelStatistics::operator==(const VoxelStatistics& other) const {
-  return resolution_m_ == other.resolution_m_ && cells_ == other.cells_;
+  return resolution_m_ == other.resolution_m_ && cells_ == other.cells_ &&
+         circle_cells_ == other.circle_cells_;
 }
 
 std::vector<Eigen::Vector3d> voxelDownsample(std::span<const Eigen::Vector3d> points,

@@ -7,7 +7,16 @@
 // Target: voxel cells with the mean and covariance of their points; a covariance's eigenvalues
 // are clamped from below to min_eigenvalue_ratio times the largest (Magnusson 6.2); a cell whose
 // points lie along a line (its middle eigenvalue below line_cell_ratio times the largest) is not
-// used (docs/registration.md, "Line cells"). Each source
+// used (docs/registration.md, "Line cells").
+//
+// Stem cells (`stem_cells`): a cell whose horizontal section is a circle's arc (a stem, seen
+// from one side or many) scores a point by its distance to that circle instead of to the
+// Gaussian: the point's mu is the circle's point nearest it (at the cell mean's height) and its
+// Sigma^-1 = n n^T / sigma_r^2 + e_z e_z^T / sigma_z^2 with n the radial direction. A Gaussian of
+// the arc a keyframe saw sits on that keyframe's side of the stem and pulls a scan that sees
+// another arc toward the keyframe (docs/registration.md, "Bias"); the circle is the same from
+// every side. The circle is Taubin's algebraic fit to the cell's horizontal moments. Each source
+// point x' = T x contributes the normal-plus-uniform mixture score
 // point x' = T x contributes the normal-plus-uniform mixture score
 //     f = d1 * exp(-d2 / 2 * (x' - mu)^T Sigma^-1 (x' - mu))
 // per neighbour cell (d1 < 0, so f is minimized; Magnusson Eq. 6.9-6.10). T = T_target_source is
@@ -52,6 +61,8 @@ struct NdtConfig {
   /// A cell whose middle eigenvalue is below this share of its largest holds a line of points
   /// (one scan's ring across the ground, which moves with the sensor): not used; 0 keeps them.
   double line_cell_ratio = 0.02;
+  /// Score cells holding a stem's section against its circle (see above); off by default.
+  bool stem_cells = false;
   int max_iterations = 35;         ///< per resolution
   double step_epsilon_m = 1e-3;    ///< converged when the translation step is below this...
   double step_epsilon_rad = 1e-4;  ///< ...and the rotation step below this
@@ -75,7 +86,21 @@ struct NdtCell {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();          ///< regularized, m^2
   Eigen::Matrix3d inverse_covariance = Eigen::Matrix3d::Identity();  ///< of the regularized one
   std::size_t count = 0;
+  /// A stem cell (NdtConfig::stem_cells): the circle of its horizontal section in the target
+  /// frame, and the inverse variances of a point's distance to it and of its height.
+  bool stem = false;
+  Eigen::Vector2d stem_centre = Eigen::Vector2d::Zero();
+  double stem_radius_m = 0.0;
+  double inverse_radial_variance = 0.0;    ///< 1 / m^2
+  double inverse_vertical_variance = 0.0;  ///< 1 / m^2
 };
+
+/// The circle of a cell's horizontal section, when it is a stem's: radius within
+/// [0.03 m, half the cell], an arc of about 80 deg or more, residuals small against the radius
+/// and the section upright; the radial variance is at least min_variance_m2. `cell` keeps its
+/// Gaussian either way.
+bool fitStemSection(const CellMoments& m, double resolution_m, double min_variance_m2,
+                    NdtCell& cell);
 
 /// Target cells with a hash index; built once, read concurrently.
 class NdtTarget {

@@ -1,0 +1,152 @@
+// NDT stem cells (ndt.hpp, "Stem cells"; docs/registration.md, "Bias"): a Gaussian of the arc of
+// a stem that the map's sensor saw sits on that sensor's side; a scan from elsewhere sees another
+// arc and is pulled toward the map's viewpoint. The circle fitted to the cell's horizontal
+// moments is the same from every side.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "taiga/lie/se3.hpp"
+#include "taiga/registration/ndt.hpp"
+#include "taiga/registration/voxel_statistics.hpp"
+
+namespace taiga::registration {
+namespace {
+
+TEST(VoxelStatistics, CircleMomentsAreTheSectionsCentralMoments) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.02, 0.48);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 200; ++i) points.emplace_back(10.0 + u(rng), -20.0 + u(rng), 1.0 + u(rng));
+  VoxelStatistics stats(0.5, true);
+  stats.add(points);
+  const std::vector<CellMoments> cells = stats.moments();
+  ASSERT_EQ(cells.size(), 1u);
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : points) mean += p.head<2>() / 200.0;
+  double xw = 0, yw = 0, ww = 0;
+  for (const auto& p : points) {
+    const Eigen::Vector2d d = p.head<2>() - mean;
+    const double w = d.squaredNorm();
+    xw += d.x() * w / 200.0;
+    yw += d.y() * w / 200.0;
+    ww += w * w / 200.0;
+  }
+  // 10 um quanta: within 1e-4 of the moments (the means of 200 points).
+  EXPECT_NEAR(cells[0].xw, xw, 1e-7);
+  EXPECT_NEAR(cells[0].yw, yw, 1e-7);
+  EXPECT_NEAR(cells[0].ww, ww, 2e-8);
+  EXPECT_GT(std::abs(xw) + std::abs(yw), 1e-5);  // not trivially zero
+  // Removing the points empties the statistics exactly.
+  stats.remove(points);
+  EXPECT_EQ(stats.numCells(), 0u);
+  EXPECT_TRUE(stats == VoxelStatistics(0.5, true));
+  // Statistics without them cannot make stem cells.
+  NdtConfig config;
+  config.stem_cells = true;
+  EXPECT_THROW(NdtTarget(VoxelStatistics(0.5), config), std::logic_error);
+}
+
+/// Points on the arc of a circle (centre c, radius r) facing `from`, half-angle `half_rad`, at
+/// heights z0..z0+0.45 m, with range-like noise.
+std::vector<Eigen::Vector3d> arc(const Eigen::Vector2d& c, double r, const Eigen::Vector2d& from,
+                                 double half_rad, double z0, double noise_m, std::mt19937& rng) {
+  std::normal_distribution<double> normal(0.0, noise_m);
+  const Eigen::Vector2d to = (from - c).normalized();
+  const double facing = std::atan2(to.y(), to.x());
+  std::vector<Eigen::Vector3d> points;
+  for (double z = z0 + 0.02; z < z0 + 0.48; z += 0.05)
+    for (double a = -half_rad; a <= half_rad; a += 0.05) {
+      const Eigen::Vector2d p =
+          c + (r + normal(rng)) * Eigen::Vector2d(std::cos(facing + a), std::sin(facing + a));
+      points.emplace_back(p.x(), p.y(), z);
+    }
+  return points;
+}
+
+TEST(NdtStemCells, TheCircleOfAStemsArcIsFitted) {
+  std::mt19937 rng(5);
+  NdtConfig config;
+  config.resolution_m = 0.5;
+  config.stem_cells = true;
+  // A 12 cm stem in one cell, seen as a 140 deg arc with 5 mm noise.
+  const Eigen::Vector2d centre(3.25, 1.25);
+  const auto stem = arc(centre, 0.12, {0.0, 0.0}, 1.22, 0.5, 0.005, rng);
+  const NdtTarget target = NdtTarget::fromPoints(stem, 0.5, config);
+  ASSERT_EQ(target.cells().size(), 1u);
+  const NdtCell& cell = target.cells()[0];
+  ASSERT_TRUE(cell.stem);
+  EXPECT_NEAR((cell.stem_centre - centre).norm(), 0.0, 0.005);
+  EXPECT_NEAR(cell.stem_radius_m, 0.12, 0.005);
+  // Without the option the cell is a Gaussian only.
+  EXPECT_FALSE(NdtTarget::fromPoints(stem, 0.5).cells()[0].stem);
+}
+
+TEST(NdtStemCells, WallsBlobsAndShortArcsAreNotStems) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(0.01, 0.49);
+  NdtConfig config;
+  config.resolution_m = 0.5;
+  config.stem_cells = true;
+  std::vector<Eigen::Vector3d> wall, blob;
+  for (int i = 0; i < 100; ++i) wall.emplace_back(0.25, u(rng), u(rng));
+  for (int i = 0; i < 100; ++i) blob.emplace_back(u(rng), u(rng), u(rng));
+  for (const auto* points : {&wall, &blob}) {
+    const NdtTarget target = NdtTarget::fromPoints(*points, 0.5, config);
+    ASSERT_EQ(target.cells().size(), 1u);
+    EXPECT_FALSE(target.cells()[0].stem);
+  }
+  // 34 deg of a 20 cm stem: the circle is not determined.
+  const auto short_arc = arc({0.35, 0.25}, 0.2, {-5.0, 0.25}, 0.3, 0.0, 0.003, rng);
+  const NdtTarget target = NdtTarget::fromPoints(short_arc, 0.5, config);
+  ASSERT_EQ(target.cells().size(), 1u);
+  EXPECT_FALSE(target.cells()[0].stem);
+}
+
+/// A scan 4 m ahead of the map's viewpoint, registered from its true pose: the map saw each stem
+/// from (0, 0), the scan from (4, 0); flat ground below. The error along the walk (m).
+double pullAlongWalk_m(bool stem_cells) {
+  std::mt19937 rng(7);
+  const Eigen::Vector2d stems[] = {{2.25, 3.25}, {1.75, -3.25}, {4.25, 4.25},
+                                   {3.25, -3.75}, {6.25, 2.75}, {5.75, -2.25}};
+  std::vector<Eigen::Vector3d> map, scan_in_world;
+  for (const Eigen::Vector2d& c : stems)
+    for (double z0 = -1.0; z0 < 1.5; z0 += 0.5) {
+      for (const auto& p : arc(c, 0.12, {0.0, 0.0}, 1.3, z0, 0.005, rng)) map.push_back(p);
+      for (const auto& p : arc(c, 0.12, {4.0, 0.0}, 1.3, z0, 0.005, rng))
+        scan_in_world.push_back(p);
+    }
+  std::uniform_real_distribution<double> u(-8.0, 8.0);
+  for (int i = 0; i < 4000; ++i) {
+    map.emplace_back(u(rng), u(rng), -1.2);
+    scan_in_world.emplace_back(u(rng), u(rng), -1.2);
+  }
+  const lie::SE3 T_world_scan(lie::SO3(), Eigen::Vector3d(4.0, 0.0, 0.0));
+  std::vector<Eigen::Vector3d> scan;
+  for (const auto& p : scan_in_world) scan.push_back(T_world_scan.inverse() * p);
+  NdtConfig config;
+  config.resolution_m = 0.5;
+  config.stem_cells = stem_cells;
+  const RegistrationResult result = alignNdt(scan, map, T_world_scan, config);
+  EXPECT_TRUE(result.converged);
+  return result.T_target_source.translation().x() - 4.0;
+}
+
+TEST(NdtStemCells, AScanIsNotMovedByTheArcsItsViewpointSaw) {
+  const double gaussian_m = pullAlongWalk_m(false);
+  const double circles_m = pullAlongWalk_m(true);
+  std::printf("error along the walk: Gaussian cells %+.4f m, stem cells %+.4f m\n", gaussian_m,
+              circles_m);
+  // The arcs' Gaussians sit on the sides each sensor saw and move the scan (+1.8 cm written).
+  EXPECT_GT(std::abs(gaussian_m), 0.005);
+  EXPECT_LT(std::abs(circles_m), 0.2 * std::abs(gaussian_m));
+  EXPECT_LT(std::abs(circles_m), 0.002);
+}
+
+}  // namespace
+}  // namespace taiga::registration
