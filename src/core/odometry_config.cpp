@@ -104,7 +104,8 @@ void OdometryConfig::visit(ConfigVisitor& v) {
            "neighbours (direct7)");
   v.field("ndt_stem_cells", ndt_stem_cells,
           "true: NDT cells holding a stem's section score points by their distance to its "
-          "circle, the same from every side (less shrink; docs/registration.md, Bias)");
+          "circle, the same from every side (half the shrink, but not yet robust in a lidar-only "
+          "re-attachment; docs/registration.md, Bias)");
   v.field("local_map_voxel_m", local_map_voxel_m, "m, spacing of keyframe points in the local map");
   v.field("local_map_keyframes", local_map_keyframes, "keyframes held in the local map");
   v.field("lidar_sigma", lidar_sigma,

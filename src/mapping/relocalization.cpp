@@ -63,7 +63,8 @@ class NdtPasses {
   NdtPasses(std::span<const Eigen::Vector3d> target, const registration::NdtConfig& config)
       : config_(config) {
     for (const double resolution_m : config.coarse_resolutions_m)
-      targets_.push_back(registration::NdtTarget::fromPoints(target, resolution_m, config));
+      targets_.push_back(
+          registration::NdtTarget::fromPoints(target, resolution_m, config.cellsAt(resolution_m)));
     targets_.push_back(registration::NdtTarget::fromPoints(target, config.resolution_m, config));
   }
 

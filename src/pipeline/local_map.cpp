@@ -27,7 +27,7 @@ void LocalMap::setNdtResolutions(const std::vector<double>& ndt_resolutions_m) {
   // Only the NDT target needs cells; GICP uses the points.
   if (target_ == Target::kNdt)
     for (double resolution_m : ndt_resolutions_m)
-      ndt_statistics_.emplace_back(resolution_m, ndt_cells_.stem_cells);
+      ndt_statistics_.emplace_back(resolution_m, ndt_cells_.cellsAt(resolution_m).stem_cells);
 }
 
 LocalMap::~LocalMap() {
@@ -41,8 +41,8 @@ LocalMap::SearchStructures LocalMap::build() const {
   std::vector<Eigen::Vector3d> points;
   auto build_ndt = [&] {
     for (const registration::VoxelStatistics& statistics : ndt_statistics_)
-      built.ndt_targets.push_back(
-          std::make_unique<registration::NdtTarget>(statistics, ndt_cells_));
+      built.ndt_targets.push_back(std::make_unique<registration::NdtTarget>(
+          statistics, ndt_cells_.cellsAt(statistics.resolution_m())));
   };
   auto build_points = [&] {
     points = point_statistics_.means();

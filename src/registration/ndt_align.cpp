@@ -121,7 +121,8 @@ RegistrationResult coarseToFine(std::span<const Eigen::Vector3d> source,
   RegistrationResult result;
   int iterations = 0;
   for (double resolution : resolutions(config)) {
-    const NdtTarget ndt_target = NdtTarget::fromPoints(target, resolution, config);
+    const NdtTarget ndt_target =
+        NdtTarget::fromPoints(target, resolution, config.cellsAt(resolution));
     result = align_one(source, ndt_target, T, config);
     iterations += result.iterations;
     if (result.num_inliers == 0) break;

@@ -61,7 +61,8 @@ struct NdtConfig {
   /// A cell whose middle eigenvalue is below this share of its largest holds a line of points
   /// (one scan's ring across the ground, which moves with the sensor): not used; 0 keeps them.
   double line_cell_ratio = 0.02;
-  /// Score cells holding a stem's section against its circle (see above); off by default.
+  /// Score cells holding a stem's section against its circle (see above), at resolution_m
+  /// only: the coarser passes are there for their wide basin. Off by default.
   bool stem_cells = false;
   int max_iterations = 35;         ///< per resolution
   double step_epsilon_m = 1e-3;    ///< converged when the translation step is below this...
@@ -78,6 +79,12 @@ struct NdtConfig {
   double max_translation_condition = 50.0;
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
+  /// The cell rules for a target at `resolution_m`: stem cells at the finest resolution only.
+  NdtConfig cellsAt(double target_resolution_m) const {
+    NdtConfig cells = *this;
+    cells.stem_cells = stem_cells && target_resolution_m == resolution_m;
+    return cells;
+  }
 };
 
 /// One NDT cell of the target.
