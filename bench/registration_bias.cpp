@@ -155,7 +155,8 @@ registration::RegistrationResult align(const Options& o, std::span<const Eigen::
   if (o.coarse_resolution_m > 0.0) {
     start = registration::alignNdt(
                 source,
-                registration::NdtTarget::fromPoints(map_in_world, o.coarse_resolution_m, ndt),
+                registration::NdtTarget::fromPoints(map_in_world, o.coarse_resolution_m,
+                                                    ndt.cellsAt(o.coarse_resolution_m)),
                 guess, ndt)
                 .T_target_source;
   }

@@ -83,8 +83,10 @@ TEST(NdtStemCells, TheCircleOfAStemsArcIsFitted) {
   ASSERT_TRUE(cell.stem);
   EXPECT_NEAR((cell.stem_centre - centre).norm(), 0.0, 0.005);
   EXPECT_NEAR(cell.stem_radius_m, 0.12, 0.005);
-  // Without the option the cell is a Gaussian only.
+  // Without the option the cell is a Gaussian only, and so are coarser passes' cells.
   EXPECT_FALSE(NdtTarget::fromPoints(stem, 0.5).cells()[0].stem);
+  EXPECT_TRUE(config.cellsAt(0.5).stem_cells);
+  EXPECT_FALSE(config.cellsAt(1.0).stem_cells);
 }
 
 TEST(NdtStemCells, WallsBlobsAndShortArcsAreNotStems) {

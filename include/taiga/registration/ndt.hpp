@@ -15,9 +15,10 @@
 // Sigma^-1 = n n^T / sigma_r^2 + e_z e_z^T / sigma_z^2 with n the radial direction. A Gaussian of
 // the arc a keyframe saw sits on that keyframe's side of the stem and pulls a scan that sees
 // another arc toward the keyframe (docs/registration.md, "Bias"); the circle is the same from
-// every side. The circle is Taubin's algebraic fit to the cell's horizontal moments. Each source
-// point x' = T x contributes the normal-plus-uniform mixture score
-// point x' = T x contributes the normal-plus-uniform mixture score
+// every side. The circle is Taubin's algebraic fit to the cell's horizontal moments. Coarser
+// targets than resolution_m keep Gaussians (NdtConfig::cellsAt).
+//
+// Each source point x' = T x contributes the normal-plus-uniform mixture score
 //     f = d1 * exp(-d2 / 2 * (x' - mu)^T Sigma^-1 (x' - mu))
 // per neighbour cell (d1 < 0, so f is minimized; Magnusson Eq. 6.9-6.10). T = T_target_source is
 // perturbed on the right, T * Exp(tau) with tau = [rho; theta] (lie/se3.hpp); the gradient and
