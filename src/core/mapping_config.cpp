@@ -33,6 +33,10 @@ void MappingConfig::visit(ConfigVisitor& v) {
           "m, the search reaches this far on each side of the dead-reckoned position, in x and y");
   v.field("relocalization_search_deg", relocalization_search_deg,
           "deg, and this far on each side of the dead-reckoned heading");
+  v.field("relocalization_stems", relocalization_stems,
+          "also search where the segment's stems match the map's stems (any heading, within "
+          "loop_max_search_radius_m): dead reckoning after a long gap can be farther off than "
+          "the window");
   v.field("trees", trees,
           "detect stems while the run goes and keep RUN/trees.csv up to date (docs/trees.md)");
   v.field("odometry_sigma_m", odometry_sigma_m,

@@ -74,6 +74,15 @@ bool Mapper::linking(std::uint64_t segment, std::size_t current) const {
          current - links->second.first_keyframe < kSegmentLinkKeyframes;
 }
 
+KeyframeStemMarks Mapper::stemMarksOf() {
+  if (!config_.relocalization_stems) return {};
+  return [this](std::size_t k) -> const std::vector<StemMark>& {
+    auto [it, fresh] = stem_marks_.try_emplace(k);
+    if (fresh) it->second = scanStemMarks(store_.load(k), graph_.pose(k).rotation());
+    return it->second;
+  };
+}
+
 void Mapper::tryRelocalization(std::size_t current, double t_s) {
   if (last_relocalization_s_ && t_s - *last_relocalization_s_ < config_.loop_min_interval_s) return;
   const std::uint64_t segment = graph_.segment(current);
@@ -89,7 +98,8 @@ void Mapper::tryRelocalization(std::size_t current, double t_s) {
   RelocalizationRecord record{
       .t_s = t_s,
       .segment = graph_.segment(current),
-      .attempt = relocalize(graph_, store_, current, *candidate, on_map, config_, odometry_)};
+      .attempt = relocalize(graph_, store_, current, *candidate, on_map, config_, odometry_,
+                            stemMarksOf())};
   if (record.attempt.accepted) {
     record.chi2 = graph_.addLoopIfConsistent(record.attempt.link, config_.loop_max_chi2);
     if (record.chi2 <= config_.loop_max_chi2) {

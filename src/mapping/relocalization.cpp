@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
 
 #include "taiga/core/angles.hpp"
+#include "taiga/core/log.hpp"
 #include "taiga/mapping/loop_closure.hpp"
 #include "taiga/registration/correlative_search.hpp"
 #include "taiga/registration/kdtree.hpp"
@@ -42,6 +45,8 @@ constexpr std::size_t kMinAboveGround = 200;  ///< fewer: an open field, nothing
 struct Refined {
   registration::RegistrationResult registration;
   double overlap = 0.0;
+  std::size_t candidate = 0;  ///< the keyframe whose submap it was registered in
+  lie::SE3 T_map_current;
 };
 
 /// Source points NDT refines each start with (an even sample): a link needs centimetres, not the
@@ -154,17 +159,94 @@ std::optional<std::size_t> findRelocalizationCandidate(const PoseGraph& graph, s
   return best;
 }
 
-RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& store,
-                                 std::size_t current, std::size_t candidate,
-                                 const Attached& attached, const MappingConfig& config,
-                                 const OdometryConfig& odometry) {
-  const auto start_time = std::chrono::steady_clock::now();
-  RelocalizationAttempt attempt{.current = current, .candidate = candidate};
-  const std::shared_ptr<const PointCloud> source = store.registrationCloud(current);
+namespace {
+
+/// The registrations of `starts` (T_candidate_current) in the candidate's submap, each judged by
+/// its overlap; their poses in the map frame for comparing rivals from different submaps.
+std::vector<Refined> refineInSubmap(const PoseGraph& graph, const KeyframeStore& store,
+                                    std::size_t current, std::size_t candidate,
+                                    const Attached& attached, const MappingConfig& config,
+                                    const OdometryConfig& odometry, const PointCloud& source,
+                                    const std::vector<Eigen::Vector3d>& standing,
+                                    const std::vector<lie::SE3>& starts) {
   const std::size_t half = static_cast<std::size_t>(config.loop_submap_keyframes);
   const std::vector<Eigen::Vector3d> submap =
       submapIn(graph, store, candidate, candidate >= half ? candidate - half : 0,
                std::min(candidate + half, current - 1), attached);
+  const registration::KdTree tree(submap);
+  const NdtPasses ndt(submap, loopRegistrationConfig(odometry).ndt);
+  const std::vector<Eigen::Vector3d> sample = evenSample(source.positions, kNdtSourcePoints);
+  std::vector<Refined> refined;
+  for (const lie::SE3& start : starts) {
+    registration::RegistrationResult r = ndt.align(sample, start);
+    // Fitness within a few coarse cells, as the odometry's (reported, not judged: the keyframe
+    // may stand metres from the submap's keyframes and see what they did not, so the fitness
+    // measures the submap's coverage as much as the alignment; the overlap and the rivals judge).
+    const registration::Agreement near = registration::agreement(
+        source.positions, tree, r.T_target_source, 2.0 * odometry.coarsestNdtResolutionM());
+    r.fitness_m2 = near.fitness_m2;
+    const double overlap =
+        registration::agreement(standing, tree, r.T_target_source, odometry.voxel_size_m).share;
+    const lie::SE3 T_map_current = graph.pose(candidate) * r.T_target_source;
+    refined.push_back({std::move(r), overlap, candidate, T_map_current});
+  }
+  return refined;
+}
+
+/// The segment's stems around `current` (found in the full scans of it and up to
+/// kConstellationKeyframes before it in its segment, together: one scan of 64 beams shows few
+/// whole stems) in its body frame, and the attached map's within loop_max_search_radius_m (each
+/// keyframe's, cached, placed by the graph); the motions of the first onto the second
+/// (stem_constellation.hpp) are poses T_map_current, level. Not the segment's map frame: dead
+/// reckoning through a gap turns it about every axis (a constant angular velocity), and its
+/// stems would not stand upright in it; the rig's own z is up to within its tilt.
+constexpr std::size_t kConstellationKeyframes = 5;
+std::vector<lie::SE3> constellationPoses(const PoseGraph& graph, const KeyframeStore& store,
+                                         std::size_t current, const Attached& attached,
+                                         const MappingConfig& config,
+                                         const KeyframeStemMarks& stems_of) {
+  const auto placed = [&](std::size_t k, std::vector<StemMark>& into) {
+    for (StemMark mark : stems_of(k)) {
+      mark.position_m = graph.pose(k) * mark.position_m;
+      into.push_back(mark);
+    }
+  };
+  std::vector<Eigen::Vector3d> segment_points;
+  for (std::size_t k = current + 1; k-- > 0 && current - k <= kConstellationKeyframes;) {
+    if (graph.segment(k) != graph.segment(current)) break;
+    const lie::SE3 T_current_k = graph.pose(current).inverse() * graph.pose(k);
+    for (const Eigen::Vector3d& p_k : store.load(k).positions)
+      if (p_k.allFinite()) segment_points.push_back(T_current_k * p_k);
+  }
+  const std::vector<StemMark> source = cloudStemMarks(segment_points);
+  std::vector<StemMark> target;
+  const Eigen::Vector3d& p_current = graph.pose(current).translation();
+  for (std::size_t k = 0; k < current; ++k)
+    if (attached(k) &&
+        (graph.pose(k).translation() - p_current).norm() <= config.loop_max_search_radius_m)
+      placed(k, target);
+  const std::vector<StemMark>& source_stems = source;
+  const std::vector<StemMark> target_stems = mergeStemMarks(target);
+  const std::vector<ConstellationMatch> matches = matchConstellations(source_stems, target_stems);
+  logger().debug("relocalization of keyframe {}: {} stems of the segment, {} of the map, {} matches{}",
+                 current, source_stems.size(), target_stems.size(), matches.size(),
+                 matches.empty() ? "" : fmt::format(" (best {} stems, {:.2f} m RMS)", matches.front().inliers, matches.front().rms_m));
+  std::vector<lie::SE3> poses;
+  for (const ConstellationMatch& match : matches)
+    poses.push_back(match.T_target_source);
+  return poses;
+}
+
+}  // namespace
+
+RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& store,
+                                 std::size_t current, std::size_t candidate,
+                                 const Attached& attached, const MappingConfig& config,
+                                 const OdometryConfig& odometry,
+                                 const KeyframeStemMarks& stems_of) {
+  const auto start_time = std::chrono::steady_clock::now();
+  RelocalizationAttempt attempt{.current = current, .candidate = candidate};
+  const std::shared_ptr<const PointCloud> source = store.registrationCloud(current);
   const lie::SE3 guess = graph.pose(candidate).inverse() * graph.pose(current);
   const std::vector<Eigen::Vector3d> standing = aboveGround(source->positions);
   if (standing.size() < kMinAboveGround) {
@@ -173,34 +255,48 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
     return attempt;
   }
 
-  // Wide: the search; then NDT from its best distinct starts, its cells built once.
-  const registration::KdTree tree(submap);
-  const NdtPasses ndt(submap, loopRegistrationConfig(odometry).ndt);
-  std::vector<Refined> refined;
-  const std::vector<Eigen::Vector3d> sample = evenSample(source->positions, kNdtSourcePoints);
-  for (const registration::CorrelativeCandidate& start :
-       searchCoarseToFine(source->positions, submap, guess, config)) {
-    registration::RegistrationResult r = ndt.align(sample, start.T_target_source);
-    // Fitness within a few coarse cells, as the odometry's (reported, not judged: the keyframe
-    // may stand metres from the submap's keyframes and see what they did not, so the fitness
-    // measures the submap's coverage as much as the alignment; the overlap and the rivals judge).
-    const registration::Agreement near = registration::agreement(
-        source->positions, tree, r.T_target_source, 2.0 * odometry.coarsestNdtResolutionM());
-    r.fitness_m2 = near.fitness_m2;
-    const double overlap =
-        registration::agreement(standing, tree, r.T_target_source, odometry.voxel_size_m).share;
-    refined.push_back({std::move(r), overlap});
+  // Near dead reckoning: the window search; then NDT from its best distinct starts.
+  const std::size_t half = static_cast<std::size_t>(config.loop_submap_keyframes);
+  std::vector<lie::SE3> window_starts;
+  for (const registration::CorrelativeCandidate& start : searchCoarseToFine(
+           source->positions,
+           submapIn(graph, store, candidate, candidate >= half ? candidate - half : 0,
+                    std::min(candidate + half, current - 1), attached),
+           guess, config))
+    window_starts.push_back(start.T_target_source);
+  std::vector<Refined> refined = refineInSubmap(graph, store, current, candidate, attached, config,
+                                                odometry, *source, standing, window_starts);
+  // Anywhere within the search radius: where the stems put it, each in its nearest keyframe's
+  // submap.
+  if (stems_of) {
+    for (const lie::SE3& T_map_current :
+         constellationPoses(graph, store, current, attached, config, stems_of)) {
+      std::optional<std::size_t> near;
+      double near_m = std::numeric_limits<double>::infinity();
+      for (std::size_t k = 0; k < current; ++k) {
+        const double d_m = (graph.pose(k).translation() - T_map_current.translation()).norm();
+        if (attached(k) && d_m < near_m) {
+          near = k;
+          near_m = d_m;
+        }
+      }
+      if (!near) continue;
+      const std::vector<Refined> r =
+          refineInSubmap(graph, store, current, *near, attached, config, odometry, *source,
+                         standing, {graph.pose(*near).inverse() * T_map_current});
+      refined.insert(refined.end(), r.begin(), r.end());
+    }
   }
   if (refined.empty()) {
     attempt.note = "no start found";
     return attempt;
   }
-  std::sort(refined.begin(), refined.end(),
-            [](const Refined& a, const Refined& b) { return a.overlap > b.overlap; });
+  std::stable_sort(refined.begin(), refined.end(),
+                   [](const Refined& a, const Refined& b) { return a.overlap > b.overlap; });
   const Refined& best = refined.front();
   for (const Refined& other : refined) {
-    const registration::Separation apart = registration::separation(
-        best.registration.T_target_source, other.registration.T_target_source);
+    const registration::Separation apart =
+        registration::separation(best.T_map_current, other.T_map_current);
     if (apart.m > kDistinct_m || apart.deg > kDistinct_deg) {
       attempt.rival_overlap = other.overlap;
       break;
@@ -210,13 +306,15 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_time)
           .count();
   const registration::RegistrationResult& r = best.registration;
+  attempt.candidate = best.candidate;
   attempt.overlap = best.overlap;
   attempt.fitness_m2 = r.fitness_m2;
-  const registration::Separation correction = registration::separation(guess, r.T_target_source);
+  const registration::Separation correction =
+      registration::separation(graph.pose(current), best.T_map_current);
   attempt.correction_m = correction.m;
   attempt.correction_deg = correction.deg;
-  attempt.link =
-      RelativePose{candidate, current, r.T_target_source, loopCovariance(odometry, r.fitness_m2)};
+  attempt.link = RelativePose{best.candidate, current, r.T_target_source,
+                              loopCovariance(odometry, r.fitness_m2)};
 
   if (!r.converged) {
     attempt.note = "registration did not converge: " + r.reason;

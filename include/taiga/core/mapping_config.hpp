@@ -32,6 +32,9 @@ struct MappingConfig final : ConfigSection {
   bool relocalization = true;
   double relocalization_search_m = 4.0;     ///< m, on each side, in x and in y
   double relocalization_search_deg = 45.0;  ///< deg of heading, on each side
+  /// And wherever the stems of the segment's newest keyframes match the map's stems, within
+  /// loop_max_search_radius_m (mapping/stem_constellation.hpp).
+  bool relocalization_stems = true;
   // The tree map while the run goes (pipeline/online_trees.hpp, docs/trees.md): RUN/trees.csv.
   bool trees = false;
   // Odometry between consecutive keyframes: sigma = floor + per-metre growth * distance.

@@ -90,9 +90,8 @@ struct OdometryConfig final : ConfigSection {
   double ndt_coarse_resolution_m = 1.0;
   std::string ndt_neighbours = "direct1";  ///< direct1 | direct7: NDT cells scored per point
   /// NDT cells holding a stem's section score points by their distance to its circle
-  /// (registration/ndt.hpp, "Stem cells"; docs/registration.md, "Bias"): half the shrink. Not
-  /// the default yet: docs/registration.md says why.
-  bool ndt_stem_cells = false;
+  /// (registration/ndt.hpp, "Stem cells"; docs/registration.md, "Bias"): half the shrink.
+  bool ndt_stem_cells = true;
   double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
   int local_map_keyframes = 20;            ///< keyframes the local map holds
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).

@@ -97,6 +97,8 @@ class Mapper {
   /// are then added. Returns whether it was.
   bool acceptWithAgreeingLoop(LoopRecord& record);
   void tryRelocalization(std::size_t current, double t_s);
+  /// The keyframes' stems for relocalize(), cached in stem_marks_ (empty: relocalization_stems off).
+  KeyframeStemMarks stemMarksOf();
   /// Whether a later segment still looks for links to the map rather than loops: until it is
   /// attached, and then for more links (one registration's heading error would swing the whole
   /// segment about it) within kSegmentLinkKeyframes of the first.
@@ -124,6 +126,8 @@ class Mapper {
   std::map<std::uint64_t, SegmentLinks> links_;  ///< of the re-attached segments
   std::optional<double> last_relocalization_s_;
   std::vector<RelocalizationRecord> relocalizations_;
+  /// Each keyframe's stems in its body frame, found when a relocalization first needs them.
+  std::map<std::size_t, std::vector<StemMark>> stem_marks_;
 };
 
 /// The mapping graph's poses of the newest keyframes right after it handled one keyframe: what

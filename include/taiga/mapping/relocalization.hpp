@@ -27,11 +27,13 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "taiga/core/mapping_config.hpp"
 #include "taiga/core/odometry_config.hpp"
 #include "taiga/mapping/keyframe_store.hpp"
 #include "taiga/mapping/pose_graph.hpp"
+#include "taiga/mapping/stem_constellation.hpp"
 
 namespace taiga::mapping {
 
@@ -57,10 +59,15 @@ std::optional<std::size_t> findRelocalizationCandidate(const PoseGraph& graph, s
                                                        const Attached& attached,
                                                        const MappingConfig& config);
 
-/// Searches for `current` in the candidate's submap and judges the result (see above).
+/// A keyframe's stems in its body frame (scanStemMarks, cached by the caller).
+using KeyframeStemMarks = std::function<const std::vector<StemMark>&(std::size_t keyframe)>;
+
+/// Searches for `current` in the candidate's submap and, with `stems_of`, wherever its stems match
+/// the map's (see above); judges the result.
 RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& store,
                                  std::size_t current, std::size_t candidate,
                                  const Attached& attached, const MappingConfig& config,
-                                 const OdometryConfig& odometry);
+                                 const OdometryConfig& odometry,
+                                 const KeyframeStemMarks& stems_of = {});
 
 }  // namespace taiga::mapping
