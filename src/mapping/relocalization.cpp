@@ -161,18 +161,22 @@ std::optional<std::size_t> findRelocalizationCandidate(const PoseGraph& graph, s
 
 namespace {
 
+/// The candidate's submap: its attached neighbours before `current`, in its frame.
+std::vector<Eigen::Vector3d> submapOf(const PoseGraph& graph, const KeyframeStore& store,
+                                      std::size_t current, std::size_t candidate,
+                                      const Attached& attached, const MappingConfig& config) {
+  const std::size_t half = static_cast<std::size_t>(config.loop_submap_keyframes);
+  return submapIn(graph, store, candidate, candidate >= half ? candidate - half : 0,
+                  std::min(candidate + half, current - 1), attached);
+}
+
 /// The registrations of `starts` (T_candidate_current) in the candidate's submap, each judged by
 /// its overlap; their poses in the map frame for comparing rivals from different submaps.
-std::vector<Refined> refineInSubmap(const PoseGraph& graph, const KeyframeStore& store,
-                                    std::size_t current, std::size_t candidate,
-                                    const Attached& attached, const MappingConfig& config,
+std::vector<Refined> refineInSubmap(const PoseGraph& graph, std::size_t candidate,
+                                    const std::vector<Eigen::Vector3d>& submap,
                                     const OdometryConfig& odometry, const PointCloud& source,
                                     const std::vector<Eigen::Vector3d>& standing,
                                     const std::vector<lie::SE3>& starts) {
-  const std::size_t half = static_cast<std::size_t>(config.loop_submap_keyframes);
-  const std::vector<Eigen::Vector3d> submap =
-      submapIn(graph, store, candidate, candidate >= half ? candidate - half : 0,
-               std::min(candidate + half, current - 1), attached);
   const registration::KdTree tree(submap);
   const NdtPasses ndt(submap, loopRegistrationConfig(odometry).ndt);
   const std::vector<Eigen::Vector3d> sample = evenSample(source.positions, kNdtSourcePoints);
@@ -225,12 +229,14 @@ std::vector<lie::SE3> constellationPoses(const PoseGraph& graph, const KeyframeS
     if (attached(k) &&
         (graph.pose(k).translation() - p_current).norm() <= config.loop_max_search_radius_m)
       placed(k, target);
-  const std::vector<StemMark>& source_stems = source;
   const std::vector<StemMark> target_stems = mergeStemMarks(target);
-  const std::vector<ConstellationMatch> matches = matchConstellations(source_stems, target_stems);
-  logger().debug("relocalization of keyframe {}: {} stems of the segment, {} of the map, {} matches{}",
-                 current, source_stems.size(), target_stems.size(), matches.size(),
-                 matches.empty() ? "" : fmt::format(" (best {} stems, {:.2f} m RMS)", matches.front().inliers, matches.front().rms_m));
+  const std::vector<ConstellationMatch> matches = matchConstellations(source, target_stems);
+  logger().debug("relocalization of keyframe {}: {} stems of the segment, {} of the map, {} "
+                 "matches{}",
+                 current, source.size(), target_stems.size(), matches.size(),
+                 matches.empty() ? ""
+                                 : fmt::format(" (best {} stems, {:.2f} m RMS)",
+                                               matches.front().inliers, matches.front().rms_m));
   std::vector<lie::SE3> poses;
   for (const ConstellationMatch& match : matches)
     poses.push_back(match.T_target_source);
@@ -256,16 +262,14 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
   }
 
   // Near dead reckoning: the window search; then NDT from its best distinct starts.
-  const std::size_t half = static_cast<std::size_t>(config.loop_submap_keyframes);
+  const std::vector<Eigen::Vector3d> submap =
+      submapOf(graph, store, current, candidate, attached, config);
   std::vector<lie::SE3> window_starts;
-  for (const registration::CorrelativeCandidate& start : searchCoarseToFine(
-           source->positions,
-           submapIn(graph, store, candidate, candidate >= half ? candidate - half : 0,
-                    std::min(candidate + half, current - 1), attached),
-           guess, config))
+  for (const registration::CorrelativeCandidate& start :
+       searchCoarseToFine(source->positions, submap, guess, config))
     window_starts.push_back(start.T_target_source);
-  std::vector<Refined> refined = refineInSubmap(graph, store, current, candidate, attached, config,
-                                                odometry, *source, standing, window_starts);
+  std::vector<Refined> refined =
+      refineInSubmap(graph, candidate, submap, odometry, *source, standing, window_starts);
   // Anywhere within the search radius: where the stems put it, each in its nearest keyframe's
   // submap.
   if (stems_of) {
@@ -282,8 +286,9 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
       }
       if (!near) continue;
       const std::vector<Refined> r =
-          refineInSubmap(graph, store, current, *near, attached, config, odometry, *source,
-                         standing, {graph.pose(*near).inverse() * T_map_current});
+          refineInSubmap(graph, *near, submapOf(graph, store, current, *near, attached, config),
+                         odometry, *source, standing,
+                         {graph.pose(*near).inverse() * T_map_current});
       refined.insert(refined.end(), r.begin(), r.end());
     }
   }

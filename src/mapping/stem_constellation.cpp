@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <map>
+#include <numbers>
 #include <tuple>
 
 #include "taiga/trees/inventory.hpp"
@@ -48,7 +48,8 @@ struct Motion2 {
 class TargetGrid {
  public:
   TargetGrid(std::span<const StemMark> target, double cell_m) : target_(target), cell_m_(cell_m) {
-    for (std::size_t a = 0; a < target.size(); ++a) cells_[key(target[a].position_m.head<2>())].push_back(a);
+    for (std::size_t a = 0; a < target.size(); ++a)
+      cells_[key(target[a].position_m.head<2>())].push_back(a);
   }
 
   /// The nearest target stem of similar DBH within inlier_m, or target.size().
@@ -90,7 +91,8 @@ std::vector<std::pair<std::size_t, std::size_t>> inliersOf(const Motion2& motion
                                                            const ConstellationOptions& options) {
   std::vector<std::pair<std::size_t, std::size_t>> matched;
   for (std::size_t i = 0; i < source.size(); ++i) {
-    const std::size_t a = grid.nearest(source[i], motion.apply(source[i].position_m.head<2>()), options);
+    const std::size_t a =
+        grid.nearest(source[i], motion.apply(source[i].position_m.head<2>()), options);
     if (a < target_size) matched.emplace_back(i, a);
   }
   return matched;
@@ -189,8 +191,10 @@ std::vector<ConstellationMatch> matchConstellations(std::span<const StemMark> so
         if (!sameDbh(source[s.a], target[ta], options) ||
             !sameDbh(source[s.b], target[tb], options))
           continue;
-        const Eigen::Vector2d ds = source[s.b].position_m.head<2>() - source[s.a].position_m.head<2>();
-        const Eigen::Vector2d dt = target[tb].position_m.head<2>() - target[ta].position_m.head<2>();
+        const Eigen::Vector2d ds =
+            source[s.b].position_m.head<2>() - source[s.a].position_m.head<2>();
+        const Eigen::Vector2d dt =
+            target[tb].position_m.head<2>() - target[ta].position_m.head<2>();
         Motion2 motion{.yaw_rad = std::atan2(dt.y(), dt.x()) - std::atan2(ds.y(), ds.x())};
         const Eigen::Vector2d mid_s =
             0.5 * (source[s.a].position_m.head<2>() + source[s.b].position_m.head<2>());

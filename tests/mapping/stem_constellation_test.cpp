@@ -69,9 +69,8 @@ TEST(StemConstellation, AnotherForestMatchesOnlyByChanceAndWeakly) {
 }
 
 TEST(StemConstellation, MergesTheSameStemSeenFromSeveralKeyframes) {
-  const std::vector<StemMark> marks = {{{0.0, 0.0, 1.3}, 0.20},
-                                       {{0.1, 0.0, 1.4}, 0.22},
-                                       {{2.0, 0.0, 1.3}, 0.30}};
+  const std::vector<StemMark> marks = {
+      {{0.0, 0.0, 1.3}, 0.20}, {{0.1, 0.0, 1.4}, 0.22}, {{2.0, 0.0, 1.3}, 0.30}};
   const std::vector<StemMark> merged = mergeStemMarks(marks);
   ASSERT_EQ(merged.size(), 2u);
   EXPECT_NEAR(merged[0].position_m.x(), 0.05, 1e-12);

@@ -97,7 +97,8 @@ class Mapper {
   /// are then added. Returns whether it was.
   bool acceptWithAgreeingLoop(LoopRecord& record);
   void tryRelocalization(std::size_t current, double t_s);
-  /// The keyframes' stems for relocalize(), cached in stem_marks_ (empty: relocalization_stems off).
+  /// The keyframes' stems for relocalize(), cached in stem_marks_ (none when relocalization_stems
+  /// is off).
   KeyframeStemMarks stemMarksOf();
   /// Whether a later segment still looks for links to the map rather than loops: until it is
   /// attached, and then for more links (one registration's heading error would swing the whole
