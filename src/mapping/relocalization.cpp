@@ -142,21 +142,32 @@ std::vector<Eigen::Vector3d> aboveGround(const std::vector<Eigen::Vector3d>& poi
 
 }  // namespace
 
-std::optional<std::size_t> findRelocalizationCandidate(const PoseGraph& graph, std::size_t current,
-                                                       const Attached& attached,
-                                                       const MappingConfig& config) {
-  const Eigen::Vector3d& p_current = graph.pose(current).translation();
+namespace {
+
+/// The attached keyframe before `current` nearest to `p_map` (graph poses), within max_m.
+std::optional<std::size_t> nearestAttached(const PoseGraph& graph, const Eigen::Vector3d& p_map,
+                                           std::size_t current, const Attached& attached,
+                                           double max_m) {
   std::optional<std::size_t> best;
-  double best_m = config.loop_max_search_radius_m;
+  double best_m = max_m;
   for (std::size_t k = 0; k < current; ++k) {
     if (!attached(k)) continue;
-    const double distance_m = (graph.pose(k).translation() - p_current).norm();
+    const double distance_m = (graph.pose(k).translation() - p_map).norm();
     if (distance_m <= best_m) {
       best = k;
       best_m = distance_m;
     }
   }
   return best;
+}
+
+}  // namespace
+
+std::optional<std::size_t> findRelocalizationCandidate(const PoseGraph& graph, std::size_t current,
+                                                       const Attached& attached,
+                                                       const MappingConfig& config) {
+  return nearestAttached(graph, graph.pose(current).translation(), current, attached,
+                         config.loop_max_search_radius_m);
 }
 
 namespace {
@@ -275,15 +286,9 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
   if (stems_of) {
     for (const lie::SE3& T_map_current :
          constellationPoses(graph, store, current, attached, config, stems_of)) {
-      std::optional<std::size_t> near;
-      double near_m = std::numeric_limits<double>::infinity();
-      for (std::size_t k = 0; k < current; ++k) {
-        const double d_m = (graph.pose(k).translation() - T_map_current.translation()).norm();
-        if (attached(k) && d_m < near_m) {
-          near = k;
-          near_m = d_m;
-        }
-      }
+      const std::optional<std::size_t> near =
+          nearestAttached(graph, T_map_current.translation(), current, attached,
+                          std::numeric_limits<double>::infinity());
       if (!near) continue;
       const std::vector<Refined> r =
           refineInSubmap(graph, *near, submapOf(graph, store, current, *near, attached, config),
