@@ -117,7 +117,9 @@ void printCalibration(const pipeline::CalibrationRunReport& c) {
       c.rotation_change_deg,
       c.rotation_observable_axes.empty() ? "none" : c.rotation_observable_axes);
   if (!c.advice.empty()) fmt::print("           {}\n", c.advice);
-  if (!c.gyro_noise_text.empty()) fmt::print("           {}\n", c.gyro_noise_text);
+  if (!c.gyro_noise_text.empty())
+    fmt::print("           {}{}\n", c.gyro_noise_text,
+               c.gyro_noise_applied ? " (applied for this run: calibration.apply_gyro_noise)" : "");
 }
 
 // Ctrl-C and SIGTERM end a live run cleanly: the packet streams end, the run finishes and writes

@@ -13,6 +13,9 @@ void CalibrationConfig::visit(ConfigVisitor& v) {
           "deg; a rotation less certain than this about an axis stays as configured");
   v.field("max_translation_sigma_m", max_translation_sigma_m,
           "m; a lever arm less certain than this along a direction stays as configured");
+  v.field("apply_gyro_noise", apply_gyro_noise,
+          "true: at_start replaces an odometry.imu.gyro_noise_density that the data show to be "
+          "understated by the measured one");
   v.field("track_offset", track_offset,
           "true: taiga run keeps estimating rig.lidar_time_offset_s from its last track_window_s "
           "of scans and applies it (a lidar clock drifts against the IMU's)");

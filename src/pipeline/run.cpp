@@ -161,8 +161,15 @@ CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording,
       report.gyro_noise_measured = c.gyro_noise->density_radps_sqrthz;
       report.gyro_noise_sigma = c.gyro_noise->density_sigma;
     }
-    if (c.gyro_noise_verdict.kind == calib::NoiseVerdict::Kind::kUnderstated)
-      logger().warn("{}", c.gyro_noise_verdict.text);
+    if (c.gyro_noise_verdict.kind == calib::NoiseVerdict::Kind::kUnderstated) {
+      report.gyro_noise_applied = config.calibration.apply_gyro_noise;
+      if (report.gyro_noise_applied) {
+        config.odometry.imu.gyro_noise_density = c.gyro_noise_verdict.suggested;
+        logger().info("{}; the run uses the measured density", c.gyro_noise_verdict.text);
+      } else {
+        logger().warn("{}", c.gyro_noise_verdict.text);
+      }
+    }
   } catch (const std::exception& e) {  // bad input or a pass that failed: the run goes on
     report.skipped = e.what();
     logger().warn("calibration at the start skipped, the configured rig is used: {}", e.what());

@@ -103,6 +103,7 @@ nlohmann::ordered_json calibrationJson(const CalibrationRunReport& c) {
             {"measured_radps_sqrthz", c.gyro_noise_measured},
             {"sigma_radps_sqrthz", c.gyro_noise_sigma},
             {"suggested_radps_sqrthz", c.gyro_noise_suggested},
+            {"applied", c.gyro_noise_applied},
             {"text", c.gyro_noise_text}}}};
 }
 

@@ -18,6 +18,11 @@ struct CalibrationConfig final : ConfigSection {
   double max_offset_sigma_s = 0.002;
   double max_rotation_sigma_deg = 0.1;
   double max_translation_sigma_m = 0.01;
+  /// at_start: an odometry.imu.gyro_noise_density that the data show to be understated (a
+  /// datasheet's figure; calib/gyro_noise.hpp) is replaced by the measured one for the run. A
+  /// filter told the gyro is better than it is follows the gyro's scale errors through every
+  /// turn (docs/calibration.md, "IMU noise").
+  bool apply_gyro_noise = true;
   /// `taiga run` follows the lidar-IMU time offset through the run: a free-running lidar clock
   /// drifts against the IMU's by 10-50 ppm, 18 ms after 30 min at 10 ppm (pipeline/
   /// clock_tracker.hpp). Re-estimated every track_every_s from the last track_window_s of scans.

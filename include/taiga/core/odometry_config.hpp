@@ -97,7 +97,7 @@ struct OdometryConfig final : ConfigSection {
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
   double lidar_sigma =
       0.01;  ///< sigma_sm: m and rad (roll, pitch; heading unless set below), at good fitness
-  double lidar_heading_sigma_rad = 0.003;  ///< heading sigma at good fitness; 0: lidar_sigma
+  double lidar_heading_sigma_rad = 0.001;  ///< heading sigma at good fitness; 0: lidar_sigma
   double fitness_threshold_m2 = 0.3;       ///< tau_fs
   double fitness_sigma_exponent = 2.0;     ///< theta_smsc
   // Rejection of registrations that disagree with the IMU prediction or did not work.

@@ -132,11 +132,13 @@ struct CalibrationRunReport {
   std::string rotation_observable_axes;                          ///< e.g. "xyz", "xy", "" (none)
   std::string advice;  ///< what motion would calibrate what was not observable
   /// The gyro's noise density measured against the registrations (calib/gyro_noise.hpp) and the
-  /// verdict on odometry.imu.gyro_noise_density: reported, not applied (docs/calibration.md).
+  /// verdict on odometry.imu.gyro_noise_density; an understated one is replaced by the suggestion
+  /// when calibration.apply_gyro_noise (docs/calibration.md).
   std::string gyro_noise_verdict = "undetermined";
   std::string gyro_noise_text;
   double gyro_noise_measured = 0.0, gyro_noise_sigma = 0.0;  ///< rad/s/sqrt(Hz); 0: not measured
   double gyro_noise_suggested = 0.0;                         ///< 0 when consistent
+  bool gyro_noise_applied = false;  ///< the run used gyro_noise_suggested
 };
 
 struct RunSummary {
