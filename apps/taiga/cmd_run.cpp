@@ -117,6 +117,14 @@ void printCalibration(const pipeline::CalibrationRunReport& c) {
       c.rotation_change_deg,
       c.rotation_observable_axes.empty() ? "none" : c.rotation_observable_axes);
   if (!c.advice.empty()) fmt::print("           {}\n", c.advice);
+  if (c.lever_arm_sigma_m.any())
+    fmt::print(
+        "           lever arm change {:.1f} {:.1f} {:.1f} cm (1-sigma {:.1f} {:.1f} {:.1f} cm), "
+        "applied along: {}\n",
+        100 * c.lever_arm_change_m.x(), 100 * c.lever_arm_change_m.y(),
+        100 * c.lever_arm_change_m.z(), 100 * c.lever_arm_sigma_m.x(),
+        100 * c.lever_arm_sigma_m.y(), 100 * c.lever_arm_sigma_m.z(),
+        c.lever_arm_applied_axes.empty() ? "none" : c.lever_arm_applied_axes);
   if (!c.gyro_noise_text.empty())
     fmt::print("           {}{}\n", c.gyro_noise_text,
                c.gyro_noise_applied ? " (applied for this run: calibration.apply_gyro_noise)" : "");

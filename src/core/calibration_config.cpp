@@ -5,7 +5,8 @@ namespace taiga {
 void CalibrationConfig::visit(ConfigVisitor& v) {
   v.field("at_start", at_start,
           "true: taiga run first estimates rig.lidar_time_offset_s and the rotation of "
-          "rig.T_body_lidar on the recording's first stretch_s, then runs with them");
+          "rig.T_body_lidar (and its lever arm, apply_lever_arm) on the recording's first "
+          "stretch_s, then runs with them");
   v.field("stretch_s", stretch_s, "s of the recording calibrated on");
   v.field("max_offset_sigma_s", max_offset_sigma_s,
           "s; a time offset less certain than this is not observable and stays as configured");
@@ -16,6 +17,9 @@ void CalibrationConfig::visit(ConfigVisitor& v) {
   v.field("apply_gyro_noise", apply_gyro_noise,
           "true: at_start replaces an odometry.imu.gyro_noise_density that the data show to be "
           "understated by the measured one");
+  v.field("apply_lever_arm", apply_lever_arm,
+          "true: the lever arm's components found to change by at least 3 sigma and 1 cm are "
+          "applied to rig.T_body_lidar");
   v.field("track_offset", track_offset,
           "true: taiga run keeps estimating rig.lidar_time_offset_s from its last track_window_s "
           "of scans and applies it (a lidar clock drifts against the IMU's)");

@@ -154,6 +154,11 @@ CalibrationRunReport calibrateAtStart(const std::filesystem::path& recording,
     report.rotation_sigma_deg = c.last.rotation_sigma_rad * kDegPerRad;
     report.rotation_observable_axes = calib::axisNames(c.last.rotation_observable);
     report.advice = c.last.advice;
+    if (c.lever_arm) {
+      report.lever_arm_change_m = c.lever_arm->correction_m;
+      report.lever_arm_sigma_m = c.lever_arm->sigma_m;
+      report.lever_arm_applied_axes = calib::axisNames(c.lever_arm_applied);
+    }
     report.gyro_noise_verdict = calib::toString(c.gyro_noise_verdict.kind);
     report.gyro_noise_text = c.gyro_noise_verdict.text;
     report.gyro_noise_suggested = c.gyro_noise_verdict.suggested;

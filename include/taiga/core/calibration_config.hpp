@@ -23,6 +23,10 @@ struct CalibrationConfig final : ConfigSection {
   /// filter told the gyro is better than it is follows the gyro's scale errors through every
   /// turn (docs/calibration.md, "IMU noise").
   bool apply_gyro_noise = true;
+  /// The lever arm's components that the motion shows (1-sigma within max_translation_sigma_m)
+  /// and that changed by at least 3 sigma and 1 cm are applied; the rest stay as configured
+  /// (docs/calibration.md, "Lever arm").
+  bool apply_lever_arm = true;
   /// `taiga run` follows the lidar-IMU time offset through the run: a free-running lidar clock
   /// drifts against the IMU's by 10-50 ppm, 18 ms after 30 min at 10 ppm (pipeline/
   /// clock_tracker.hpp). Re-estimated every track_every_s from the last track_window_s of scans.

@@ -139,6 +139,11 @@ struct CalibrationRunReport {
   double gyro_noise_measured = 0.0, gyro_noise_sigma = 0.0;  ///< rad/s/sqrt(Hz); 0: not measured
   double gyro_noise_suggested = 0.0;                         ///< 0 when consistent
   bool gyro_noise_applied = false;  ///< the run used gyro_noise_suggested
+  /// The lever arm's estimated change (body x, y, z) and its 1-sigma; the axes along which the
+  /// run applied it (calibration.apply_lever_arm), e.g. "xz", "" (none). Zero: not estimated.
+  Eigen::Vector3d lever_arm_change_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lever_arm_sigma_m = Eigen::Vector3d::Zero();
+  std::string lever_arm_applied_axes;
 };
 
 struct RunSummary {

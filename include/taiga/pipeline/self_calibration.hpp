@@ -41,13 +41,15 @@ struct SelfCalibration {
   double offset_change_s = 0.0;      ///< rig.lidar_time_offset_s minus the configured one
   lie::SO3 R_change;                 ///< R_body_lidar = R_change * R_body_lidar_configured
   calib::TimeRotationEstimate last;  ///< the last pass's estimate: its sigmas and observability
-  /// The lever arm from the last pass, reported and not applied to `rig` (self_calibration.cpp);
-  /// empty when it could not be estimated (lever_arm_failed says why).
+  /// The lever arm from the last pass; empty when it could not be estimated (lever_arm_failed
+  /// says why). With calibration.apply_lever_arm the components in lever_arm_applied are added
+  /// to `rig`'s translation (self_calibration.cpp, leverArmToApply).
   std::optional<calib::LeverArmEstimate> lever_arm;
   std::string lever_arm_failed;
+  Eigen::Vector3<bool> lever_arm_applied{false, false, false};
   /// The gyro's noise density measured in the last pass (empty when the chains were too short)
-  /// and what it says of the configured one (reported; `taiga calibrate` writes the suggestion
-  /// into its rig.yaml, `taiga run` does not apply it).
+  /// and what it says of the configured one (`taiga calibrate` writes the suggestion into its
+  /// rig.yaml; `taiga run` uses it with calibration.apply_gyro_noise).
   std::optional<calib::GyroNoiseEstimate> gyro_noise;
   calib::NoiseVerdict gyro_noise_verdict;
   std::vector<CalibrationPass> passes;
