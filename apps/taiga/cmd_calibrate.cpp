@@ -152,11 +152,6 @@ void writeCorrectedConfig(const std::filesystem::path& path, SystemConfig config
   if (!out) throw InputError(fmt::format("{}: cannot write", path.string()));
 }
 
-std::string axes(const Eigen::Vector3<bool>& observable) {
-  const std::string names = calib::axisNames(observable);
-  return names.empty() ? "none" : names;
-}
-
 int run(const CalibrateOptions& options) {
   SystemConfig config = loadConfig(options.config);
   validateAll(config);
@@ -185,7 +180,7 @@ int run(const CalibrateOptions& options) {
       "x y "
       "z; observable about: {})\n",
       c.R_change.angle() * kDegPerRad, sigma_deg.x(), sigma_deg.y(), sigma_deg.z(),
-      axes(e.rotation_observable));
+      calib::axisNamesOrNone(e.rotation_observable));
   if (c.lever_arm)
     fmt::print(
         "lever arm  change {:.1f} {:.1f} {:.1f} cm (1-sigma {:.1f} {:.1f} {:.1f} cm); applied "
@@ -193,7 +188,7 @@ int run(const CalibrateOptions& options) {
         100 * c.lever_arm->correction_m.x(), 100 * c.lever_arm->correction_m.y(),
         100 * c.lever_arm->correction_m.z(), 100 * c.lever_arm->sigma_m.x(),
         100 * c.lever_arm->sigma_m.y(), 100 * c.lever_arm->sigma_m.z(),
-        c.lever_arm_applied.any() ? axes(c.lever_arm_applied) : "none");
+        calib::axisNamesOrNone(c.lever_arm_applied));
   else
     fmt::print("lever arm  not estimated: {}\n", c.lever_arm_failed);
   fmt::print("gyro       bias {:.5f} {:.5f} {:.5f} rad/s; residual {:.3f} deg/s RMS\n",

@@ -401,6 +401,11 @@ std::string axisNames(const Eigen::Vector3<bool>& which) {
   return names;
 }
 
+std::string axisNamesOrNone(const Eigen::Vector3<bool>& which) {
+  const std::string names = axisNames(which);
+  return names.empty() ? "none" : names;
+}
+
 lie::SO3 integrateGyro(const std::vector<GyroReading>& gyro, double t0_s, double t1_s,
                        const Eigen::Vector3d& bias_radps) {
   if (gyro.empty() || gyro.front().t_s > t0_s || gyro.back().t_s < t1_s)

@@ -181,32 +181,50 @@ std::vector<Eigen::Vector3d> submapOf(const PoseGraph& graph, const KeyframeStor
                   std::min(candidate + half, current - 1), attached);
 }
 
-/// The registrations of `starts` (T_candidate_current) in the candidate's submap, each judged by
-/// its overlap; their poses in the map frame for comparing rivals from different submaps.
-std::vector<Refined> refineInSubmap(const PoseGraph& graph, std::size_t candidate,
-                                    const std::vector<Eigen::Vector3d>& submap,
-                                    const OdometryConfig& odometry, const PointCloud& source,
-                                    const std::vector<Eigen::Vector3d>& standing,
-                                    const std::vector<lie::SE3>& starts) {
-  const registration::KdTree tree(submap);
-  const NdtPasses ndt(submap, loopRegistrationConfig(odometry).ndt);
-  const std::vector<Eigen::Vector3d> sample = evenSample(source.positions, kNdtSourcePoints);
-  std::vector<Refined> refined;
-  for (const lie::SE3& start : starts) {
-    registration::RegistrationResult r = ndt.align(sample, start);
+/// A keyframe's submap with its search structures, built once per attempt that refines in it;
+/// refine() registers the current keyframe from a start T_candidate_current and judges it by its
+/// overlap, with its pose in the map frame for comparing rivals from different submaps.
+class SubmapRefiner {
+ public:
+  SubmapRefiner(const PoseGraph& graph, const KeyframeStore& store, std::size_t current,
+                std::size_t candidate, const Attached& attached, const MappingConfig& config,
+                const OdometryConfig& odometry)
+      : candidate_(candidate),
+        T_map_candidate_(graph.pose(candidate)),
+        odometry_(odometry),
+        submap_(submapOf(graph, store, current, candidate, attached, config)),
+        tree_(submap_),
+        ndt_(submap_, loopRegistrationConfig(odometry).ndt) {}
+  SubmapRefiner(const SubmapRefiner&) = delete;
+  SubmapRefiner& operator=(const SubmapRefiner&) = delete;
+
+  const std::vector<Eigen::Vector3d>& submap() const { return submap_; }
+
+  /// `sample`: the source's points NDT uses; `standing`: its points above the ground.
+  Refined refine(const lie::SE3& start, const PointCloud& source,
+                 const std::vector<Eigen::Vector3d>& sample,
+                 const std::vector<Eigen::Vector3d>& standing) const {
+    registration::RegistrationResult r = ndt_.align(sample, start);
     // Fitness within a few coarse cells, as the odometry's (reported, not judged: the keyframe
     // may stand metres from the submap's keyframes and see what they did not, so the fitness
     // measures the submap's coverage as much as the alignment; the overlap and the rivals judge).
     const registration::Agreement near = registration::agreement(
-        source.positions, tree, r.T_target_source, 2.0 * odometry.coarsestNdtResolutionM());
+        source.positions, tree_, r.T_target_source, 2.0 * odometry_.coarsestNdtResolutionM());
     r.fitness_m2 = near.fitness_m2;
     const double overlap =
-        registration::agreement(standing, tree, r.T_target_source, odometry.voxel_size_m).share;
-    const lie::SE3 T_map_current = graph.pose(candidate) * r.T_target_source;
-    refined.push_back({std::move(r), overlap, candidate, T_map_current});
+        registration::agreement(standing, tree_, r.T_target_source, odometry_.voxel_size_m).share;
+    const lie::SE3 T_map_current = T_map_candidate_ * r.T_target_source;
+    return {std::move(r), overlap, candidate_, T_map_current};
   }
-  return refined;
-}
+
+ private:
+  std::size_t candidate_;
+  lie::SE3 T_map_candidate_;
+  const OdometryConfig& odometry_;
+  std::vector<Eigen::Vector3d> submap_;
+  registration::KdTree tree_;
+  NdtPasses ndt_;
+};
 
 /// The segment's stems around `current` (found in the full scans of it and up to
 /// kConstellationKeyframes before it in its segment, together: one scan of 64 beams shows few
@@ -272,15 +290,19 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
     return attempt;
   }
 
+  // The submaps registered in, each built once (several stem matches may share one).
+  std::map<std::size_t, SubmapRefiner> refiners;
+  const auto refinerOf = [&](std::size_t k) -> const SubmapRefiner& {
+    return refiners.try_emplace(k, graph, store, current, k, attached, config, odometry)
+        .first->second;
+  };
+  const std::vector<Eigen::Vector3d> sample = evenSample(source->positions, kNdtSourcePoints);
   // Near dead reckoning: the window search; then NDT from its best distinct starts.
-  const std::vector<Eigen::Vector3d> submap =
-      submapOf(graph, store, current, candidate, attached, config);
-  std::vector<lie::SE3> window_starts;
+  const SubmapRefiner& at_candidate = refinerOf(candidate);
+  std::vector<Refined> refined;
   for (const registration::CorrelativeCandidate& start :
-       searchCoarseToFine(source->positions, submap, guess, config))
-    window_starts.push_back(start.T_target_source);
-  std::vector<Refined> refined =
-      refineInSubmap(graph, candidate, submap, odometry, *source, standing, window_starts);
+       searchCoarseToFine(source->positions, at_candidate.submap(), guess, config))
+    refined.push_back(at_candidate.refine(start.T_target_source, *source, sample, standing));
   // Anywhere within the search radius: where the stems put it, each in its nearest keyframe's
   // submap.
   if (stems_of) {
@@ -290,11 +312,8 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
           nearestAttached(graph, T_map_current.translation(), current, attached,
                           std::numeric_limits<double>::infinity());
       if (!near) continue;
-      const std::vector<Refined> r =
-          refineInSubmap(graph, *near, submapOf(graph, store, current, *near, attached, config),
-                         odometry, *source, standing,
-                         {graph.pose(*near).inverse() * T_map_current});
-      refined.insert(refined.end(), r.begin(), r.end());
+      refined.push_back(refinerOf(*near).refine(graph.pose(*near).inverse() * T_map_current,
+                                                *source, sample, standing));
     }
   }
   if (refined.empty()) {

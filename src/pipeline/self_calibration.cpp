@@ -127,11 +127,6 @@ Eigen::Vector3<bool> leverArmToApply(const calib::LeverArmEstimate& e) {
   return apply;
 }
 
-std::string leverArmAxes(const Eigen::Vector3<bool>& applied) {
-  const std::string axes = calib::axisNames(applied);
-  return axes.empty() ? "none" : axes;
-}
-
 void applyLeverArm(SelfCalibration& result) {
   const calib::LeverArmEstimate& e = *result.lever_arm;
   result.lever_arm_applied = leverArmToApply(e);
@@ -229,7 +224,7 @@ SelfCalibration selfCalibrate(const std::filesystem::path& recording, const Syst
         "applied along: {}",
         100 * e.correction_m.x(), 100 * e.correction_m.y(), 100 * e.correction_m.z(),
         100 * e.sigma_m.x(), 100 * e.sigma_m.y(), 100 * e.sigma_m.z(),
-        leverArmAxes(result.lever_arm_applied));
+        calib::axisNamesOrNone(result.lever_arm_applied));
   }
   estimateGyroNoise(last_data, config.odometry.imu.gyro_noise_density, result);
   result.offset_change_s = result.rig.lidar_time_offset_s - config.rig.lidar_time_offset_s;

@@ -83,6 +83,8 @@ Eigen::Vector3<bool> axesNotHeld(const std::vector<Eigen::Vector3d>& held);
 
 /// The names of the axes set in `which`, e.g. "xz"; empty when none.
 std::string axisNames(const Eigen::Vector3<bool>& which);
+/// axisNames, or "none" (for the terminal).
+std::string axisNamesOrNone(const Eigen::Vector3<bool>& which);
 
 /// Throws InputError when fewer than 20 increments or no gyro readings overlap them.
 TimeRotationEstimate estimateTimeRotation(const std::vector<RotationIncrement>& increments,
