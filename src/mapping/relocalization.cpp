@@ -260,15 +260,15 @@ std::vector<lie::SE3> constellationPoses(const PoseGraph& graph, const KeyframeS
       placed(k, target);
   const std::vector<StemMark> target_stems = mergeStemMarks(target);
   const std::vector<ConstellationMatch> matches = matchConstellations(source, target_stems);
-  logger().debug("relocalization of keyframe {}: {} stems of the segment, {} of the map, {} "
-                 "matches{}",
-                 current, source.size(), target_stems.size(), matches.size(),
-                 matches.empty() ? ""
-                                 : fmt::format(" (best {} stems, {:.2f} m RMS)",
-                                               matches.front().inliers, matches.front().rms_m));
+  logger().debug(
+      "relocalization of keyframe {}: {} stems of the segment, {} of the map, {} "
+      "matches{}",
+      current, source.size(), target_stems.size(), matches.size(),
+      matches.empty() ? ""
+                      : fmt::format(" (best {} stems, {:.2f} m RMS)", matches.front().inliers,
+                                    matches.front().rms_m));
   std::vector<lie::SE3> poses;
-  for (const ConstellationMatch& match : matches)
-    poses.push_back(match.T_target_source);
+  for (const ConstellationMatch& match : matches) poses.push_back(match.T_target_source);
   return poses;
 }
 
@@ -360,4 +360,3 @@ RelocalizationAttempt relocalize(const PoseGraph& graph, const KeyframeStore& st
 }
 
 }  // namespace taiga::mapping
-
