@@ -18,6 +18,8 @@ def main():
     sim, run = sys.argv[1], sys.argv[2]
     keyframes = np.loadtxt(f"{run}/keyframes/poses.tum")
     truth = np.loadtxt(f"{sim}/groundtruth.tum")
+    # A rig with a clock offset can stamp its last keyframe after the truth ends: not compared.
+    keyframes = keyframes[(keyframes[:, 0] >= truth[0, 0]) & (keyframes[:, 0] <= truth[-1, 0])]
     t = keyframes[:, 0]
     R_true = Slerp(truth[:, 0], Rotation.from_quat(truth[:, 4:8]))(t)
     p_true = np.stack([np.interp(t, truth[:, 0], truth[:, i]) for i in (1, 2, 3)], 1)
