@@ -9,6 +9,9 @@
 #include <random>
 #include <vector>
 
+#include "circle_coverage.hpp"
+#include "taiga/trees/beam_circle_fit.hpp"
+
 namespace taiga::trees {
 namespace {
 
@@ -74,7 +77,22 @@ double robustScale(std::span<const Vector2d> points_m, const Circle& circle, dou
   return std::clamp(1.4826 * median(std::move(near)), 0.003, band_m);
 }
 
-// Share of the inliers in the densest 30 deg of the circle.
+// One point's residual across the surface, e = |p - c| - r, and its gradient in (cx, cy, r):
+// de/dc = -(p - c) / |p - c|, de/dr = -1; nothing at the centre.
+struct Residual {
+  double e_m;
+  Eigen::Vector3d J;
+};
+std::optional<Residual> residualOf(const Vector2d& p, const Circle& circle) {
+  const Vector2d d = p - circle.center_m;
+  const double distance = d.norm();
+  if (!(distance > 1e-9)) return std::nullopt;
+  return Residual{distance - circle.radius_m,
+                  Eigen::Vector3d(-d.x() / distance, -d.y() / distance, -1.0)};
+}
+
+}  // namespace
+
 double densestShare(std::span<const Vector2d> points_m, const std::vector<double>& weights,
                     const Vector2d& center_m) {
   std::array<int, 36> count{};
@@ -105,44 +123,9 @@ double arcCoverageDeg(std::span<const Vector2d> points_m, const std::vector<doub
   return 10.0 * static_cast<double>(std::count(sector.begin(), sector.end(), true));
 }
 
-// One point's residual and its gradient in (cx, cy, r), or nothing when the point cannot be
-// scored (its beam misses the circle or grazes it).
-struct Residual {
-  double e_m;
-  Eigen::Vector3d J;
-};
-std::optional<Residual> residualOf(const Vector2d& p, const Vector2d* beam, const Circle& circle) {
-  const Vector2d d = p - circle.center_m;
-  const double distance = d.norm();
-  if (!(distance > 1e-9)) return std::nullopt;
-  if (beam == nullptr) {
-    // Across the surface: e = |p - c| - r; de/dc = -(p - c) / |p - c|, de/dr = -1.
-    return Residual{distance - circle.radius_m,
-                    Eigen::Vector3d(-d.x() / distance, -d.y() / distance, -1.0)};
-  }
-  // Along the beam v: p + s v meets the circle's near side at s = -(d.v) - sqrt(disc), from
-  // |d + s v|^2 = r^2; e = -s (the range error). Differentiating |q|^2 = r^2 with q = d + s v
-  // (centre to intersection): ds/dc = q / (q.v), ds/dr = r / (q.v).
-  const double b = d.dot(*beam);
-  const double disc = b * b - (distance * distance - circle.radius_m * circle.radius_m);
-  if (!(disc > 0.0)) return std::nullopt;
-  const double s = -b - std::sqrt(disc);
-  const Vector2d q = d + s * *beam;
-  const double qv = q.dot(*beam);  // -sqrt(disc): how squarely the beam meets the surface
-  // Beyond 78 deg incidence the intersection runs away with the circle: not scored.
-  if (std::abs(qv) < 0.2 * circle.radius_m) return std::nullopt;
-  return Residual{-s, Eigen::Vector3d(-q.x() / qv, -q.y() / qv, -circle.radius_m / qv)};
-}
-
-}  // namespace
-
 std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const Vector2d& center_m,
-                                      double radius_m, const CircleFitOptions& options,
-                                      std::span<const Vector2d> beams) {
+                                      double radius_m, const CircleFitOptions& options) {
   if (points_m.size() < 5) return std::nullopt;
-  const auto beamOf = [&](std::size_t i) -> const Vector2d* {
-    return beams.empty() || !(beams[i].squaredNorm() > 0.5) ? nullptr : &beams[i];
-  };
   Circle circle{center_m, radius_m};
   const double scale_m = robustScale(points_m, circle, options.inlier_band_m);
   const double tukey_m = 4.685 * scale_m;
@@ -153,7 +136,7 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const 
     JtWJ.setZero();
     Eigen::Vector3d JtWe = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < points_m.size(); ++i) {
-      const std::optional<Residual> r = residualOf(points_m[i], beamOf(i), circle);
+      const std::optional<Residual> r = residualOf(points_m[i], circle);
       const double u = r ? r->e_m / tukey_m : 1.0;
       weights[i] = std::abs(u) < 1.0 ? (1 - u * u) * (1 - u * u) : 0.0;
       if (weights[i] == 0.0) continue;
@@ -177,18 +160,15 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const 
   double weighted_sq = 0.0, weight_sum = 0.0, inlier_sq = 0.0;
   for (std::size_t i = 0; i < points_m.size(); ++i) {
     if (weights[i] <= 0.0) continue;
-    const std::optional<Residual> r = residualOf(points_m[i], beamOf(i), circle);
-    if (!r) {  // the last step moved the circle off this point's beam
+    const std::optional<Residual> r = residualOf(points_m[i], circle);
+    if (!r) {  // the point is at the centre
       weights[i] = 0.0;
       continue;
     }
     weighted_sq += weights[i] * r->e_m * r->e_m;
     weight_sum += weights[i];
-    // The RMS measures the surface's scatter across it, whichever residual was fitted.
-    const double across_m = (points_m[i] - circle.center_m).norm() - circle.radius_m;
-    inlier_sq += across_m * across_m;
+    inlier_sq += r->e_m * r->e_m;
     ++fit.inliers;
-    fit.along_beams = fit.along_beams || beamOf(i) != nullptr;
   }
   if (fit.inliers == 0) return std::nullopt;
   fit.rms_m = std::sqrt(inlier_sq / static_cast<double>(fit.inliers));
@@ -209,8 +189,12 @@ std::optional<CircleFit> fitStemSection(std::span<const Vector2d> points_m,
                                         std::span<const Vector2d> beams) {
   const std::optional<CircleFit> across = refineCircle(points_m, center_m, radius_m, options);
   if (!across || beams.empty()) return across;
-  const std::optional<CircleFit> along = refineCircle(points_m, center_m, radius_m, options, beams);
-  if (!along || along->arc_deg < 0.8 * across->arc_deg) return across;
+  // The range noise from the scatter across the surface (for a ring of points it is the range
+  // noise), kept within what lidars have: 1 cm to 5 cm.
+  const double range_sigma_m = std::clamp(across->rms_m, 0.01, 0.05);
+  const std::optional<CircleFit> along =
+      fitCircleAlongBeams(points_m, beams, center_m, radius_m, range_sigma_m, options);
+  if (!along || along->arc_deg < 0.6 * across->arc_deg) return across;
   return along;
 }
 

@@ -255,22 +255,37 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
                       upright.push_back(p.head<2>() - axis.slope * (p.z() - bh));
                       beams.push_back(index.beamOf(i));
                     });
-  const std::optional<CircleFit> dbh_fit =
-      fitStemSection(upright, axis.at_breast_height, seed.radius_m, fit, beams);
   const double max_rms_m =
       slices.size() >= o.long_stem_slices ? o.max_fit_rms_m : 2.0 / 3.0 * o.max_fit_rms_m;
-  if (!dbh_fit || dbh_fit->arc_deg < o.min_arc_deg || dbh_fit->rms_m > max_rms_m ||
-      dbh_fit->densest_share > o.max_densest_share || !hollow(upright, *dbh_fit))
-    return std::nullopt;
+  const auto isStem = [&](const std::optional<CircleFit>& f) {
+    return f && f->arc_deg >= o.min_arc_deg && f->rms_m <= max_rms_m &&
+           f->densest_share <= o.max_densest_share && hollow(upright, *f);
+  };
+  std::optional<CircleFit> dbh_fit =
+      fitStemSection(upright, axis.at_breast_height, seed.radius_m, fit, beams);
+  if (!isStem(dbh_fit)) return std::nullopt;
+  // The formal sigma treats the band's points as independent; views that do not quite meet move
+  // whole arcs, which the view jackknife sees (circle_fit.hpp).
+  double sigma_radius_m = std::max(
+      dbh_fit->sigma_radius_m, viewJackknifeSigmaRadius(upright, beams, *dbh_fit,
+                                                        axis.at_breast_height, seed.radius_m, fit));
+  // Along the beams a one-sided arc's radius can be left undetermined (a flat profile out to
+  // large circles): when its sigma is over a fifth of it, the fit across the surface, whose bias
+  // is small and bounded, with its own jackknife (views blocked by azimuth around the centre).
+  // On the harvester's strip road (one-sided views) the along-beam fit alone made 23 cm stems
+  // 39 cm (BENCHMARK.md, "Session 58").
+  if (dbh_fit->along_beams && sigma_radius_m > 0.2 * dbh_fit->radius_m) {
+    dbh_fit = fitStemSection(upright, axis.at_breast_height, seed.radius_m, fit);
+    if (!isStem(dbh_fit)) return std::nullopt;
+    sigma_radius_m = std::max(
+        dbh_fit->sigma_radius_m,
+        viewJackknifeSigmaRadius(upright, {}, *dbh_fit, axis.at_breast_height, seed.radius_m, fit));
+  }
   const double lean_scale = 2.0 / (1.0 + 1.0 / std::cos(lean_rad));
   Stem stem;
   stem.dbh_m = 2.0 * dbh_fit->radius_m * lean_scale;
   if (stem.dbh_m < o.min_dbh_m || stem.dbh_m > o.max_dbh_m) return std::nullopt;
-  // The formal sigma treats the band's points as independent; views that do not quite meet move
-  // whole arcs, which the view jackknife sees (circle_fit.hpp).
-  const double jackknife_sigma_m =
-      viewJackknifeSigmaRadius(upright, beams, *dbh_fit, axis.at_breast_height, seed.radius_m, fit);
-  stem.dbh_sigma_m = 2.0 * std::max(dbh_fit->sigma_radius_m, jackknife_sigma_m) * lean_scale;
+  stem.dbh_sigma_m = 2.0 * sigma_radius_m * lean_scale;
   stem.ground_z_m = terrain.heightAt(dbh_fit->center_m.x(), dbh_fit->center_m.y());
   stem.position_m = Vector3d(dbh_fit->center_m.x(), dbh_fit->center_m.y(), stem.ground_z_m + bh);
   stem.axis_slope = axis.slope;
@@ -339,7 +354,8 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
   const ColumnIndex index(std::move(slab), std::move(slab_viewpoints), 0.25);
   const CircleFitOptions fit{.min_radius_m = 0.5 * o.min_dbh_m * 0.7,
                              .max_radius_m = 0.5 * o.max_dbh_m,
-                             .inlier_band_m = o.inlier_band_m};
+                             .inlier_band_m = o.inlier_band_m,
+                             .across_beam_sigma_m = o.across_beam_sigma_m};
 
   std::vector<Stem> candidates;
   for (std::vector<Vector2d>& cluster : pixelClusters(band)) {

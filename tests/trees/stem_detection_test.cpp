@@ -104,9 +104,14 @@ OneSidedStem oneSidedStem(double sigma_m, unsigned seed) {
   return out;
 }
 
-double dbhOfTheStem(const OneSidedStem& stem, bool with_viewpoints) {
+// `across_beam_sigma_m`: how far a point may lie off its beam (CircleFitOptions); this test's
+// points lie exactly on theirs.
+double dbhOfTheStem(const OneSidedStem& stem, bool with_viewpoints,
+                    double across_beam_sigma_m = 0.01) {
+  InventoryOptions options;
+  options.stems.across_beam_sigma_m = across_beam_sigma_m;
   const Inventory inventory =
-      takeInventory(stem.points_m, {},
+      takeInventory(stem.points_m, options,
                     with_viewpoints ? Viewpoints{stem.sensor_m, stem.viewpoint_of} : Viewpoints{});
   EXPECT_EQ(inventory.stems.size(), 1u);
   return inventory.stems.empty() ? 0.0 : inventory.stems.front().dbh_m;
@@ -127,13 +132,23 @@ TEST(Stems, ViewpointsThatDoNotFitThePointsAreRefused) {
 TEST(Stems, RangeNoiseOnAOneSidedStemLeavesItsDbhUnbiasedWhenTheViewpointsAreGiven) {
   for (unsigned seed : {1u, 2u}) {
     // Across the surface the fit comes out small (refineCircle's header), the more so the larger
-    // the noise; along the beams it does not. 3.5 cm makes a `poor` stem (fit RMS over 2 cm).
+    // the noise; along the beams it does not when told the points lie on them (2 mm). With the
+    // default 1 cm across the beams (a map whose views do not quite meet) the fit slides along
+    // the surface: no gain at 1.2 cm of range noise, where the two sigmas are alike, about half
+    // the bias at 3.5 cm. 3.5 cm makes a `poor` stem (fit RMS over 2 cm).
     for (const double sigma_m : {0.012, 0.035}) {
       const OneSidedStem stem = oneSidedStem(sigma_m, seed);
-      const double across_m = dbhOfTheStem(stem, false), along_m = dbhOfTheStem(stem, true);
+      const double across_m = dbhOfTheStem(stem, false);
+      const double along_m = dbhOfTheStem(stem, true, 0.002);
+      const double default_m = dbhOfTheStem(stem, true);
       EXPECT_LT(across_m - 0.24, -0.3 * sigma_m)
           << seed << " " << sigma_m << ": the bias this test is about has gone away";
-      EXPECT_NEAR(along_m, 0.24, 0.2 * sigma_m) << seed << " " << sigma_m;
+      EXPECT_NEAR(along_m, 0.24, 0.25 * sigma_m) << seed << " " << sigma_m;
+      EXPECT_LT(std::abs(default_m - 0.24), std::abs(across_m - 0.24) + 0.001)
+          << seed << " " << sigma_m;
+      if (sigma_m > 0.03) {
+        EXPECT_LT(std::abs(default_m - 0.24), 0.6 * std::abs(across_m - 0.24)) << seed;
+      }
     }
   }
 }

@@ -22,6 +22,9 @@ struct CircleFitOptions {
   /// bark's roughness).
   double inlier_band_m = 0.025;
   int ransac_iterations = 1000;
+  /// Where beams are known (fitCircleAlongBeams): a point's 1-sigma across its beam, m (the
+  /// keyframe's placement, the beam's footprint, the bark).
+  double across_beam_sigma_m = 0.01;
   std::uint64_t seed = 1;  ///< the RANSAC draws are deterministic for a given seed
 };
 
@@ -45,26 +48,22 @@ std::optional<CircleFit> fitCircleRobust(std::span<const Eigen::Vector2d> points
                                          const CircleFitOptions& options = {});
 
 /// The geometric refinement alone, from a starting circle (used when the centre is known roughly,
-/// e.g. predicted from the slice below).
-///
-/// `beams`, when given, holds each point's horizontal beam direction (unit, from the sensor
-/// towards the point; a zero vector where unknown). A lidar's range noise lies along the beam,
-/// and measured across the surface it makes a one-sided arc's fit small and near the sensor
-/// (-6.5 mm radius over +-70 deg with 1.5 cm noise: bench/dbh_beam_noise.py); so each such point's
-/// residual is its distance along the beam from the circle's near side, and a point whose beam
-/// misses the circle or grazes it (beyond 78 deg) is not scored.
+/// e.g. predicted from the slice below). Its residual is across the surface; where the sensors'
+/// positions are known, fitStemSection measures along the beams (beam_circle_fit.hpp).
 std::optional<CircleFit> refineCircle(std::span<const Eigen::Vector2d> points_m,
                                       const Eigen::Vector2d& center_m, double radius_m,
-                                      const CircleFitOptions& options = {},
-                                      std::span<const Eigen::Vector2d> beams = {});
+                                      const CircleFitOptions& options = {});
 
 /// A stem section's circle from a starting circle: refineCircle across the surface, then, when
-/// `beams` are given, along them, unless that fit lost the views the first one held (its inliers
-/// cover less than 0.8 of the first fit's arc): then the fit across the surface. The along-beam
-/// residual amplifies errors across the beam (views from keyframes that do not quite meet) at
-/// oblique incidence, and a point whose beam misses the circle costs nothing, so on a scattered
-/// section it can escape to a large circle through one view's arc (docs/trees.md, "Where the DBH
-/// error comes from").
+/// `beams` are given (each point's horizontal beam direction, unit, from the sensor towards the
+/// point; a zero vector where unknown), fitCircleAlongBeams from the same start with the first
+/// fit's RMS (within 1-5 cm) as the range noise, unless its inliers cover less than 0.6 of the
+/// first fit's arc: then the fit across the surface. Across the surface, a lidar's range noise
+/// (which lies along the beam) makes a one-sided arc's circle small, and at 13 m on dark bark it
+/// fills a thin stem's visible side into a crescent whose circle is 2-4 cm too small in radius;
+/// along the beams it does not. The arc check keeps a scattered section (views from keyframes that
+/// do not quite meet) from escaping to a large circle through one view's arc (docs/trees.md,
+/// "Where the DBH error comes from").
 std::optional<CircleFit> fitStemSection(std::span<const Eigen::Vector2d> points_m,
                                         const Eigen::Vector2d& center_m, double radius_m,
                                         const CircleFitOptions& options = {},

@@ -41,6 +41,7 @@ struct StemOptions {
       5;  ///< consistent slices a stem needs, the DBH band included (1.5 m of stem)
   double max_lean_deg = 25.0;
   double inlier_band_m = 0.025;  ///< see CircleFitOptions
+  double across_beam_sigma_m = 0.01;  ///< see CircleFitOptions
   double min_arc_deg = 60.0;     ///< a DBH fit on less of the circle is not reported
   /// Nor one whose inliers scatter more (foliage, clutter that happens to make a ring); a stem
   /// tracked through fewer than long_stem_slices slices must scatter less than 2/3 of it: on noisy
