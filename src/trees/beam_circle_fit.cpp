@@ -111,7 +111,7 @@ Irls irls(std::span<const Vector2d> points_m, std::span<const Vector2d> beams, C
       state.JtWJ += e2 > 1e-18 ? Eigen::Matrix3d(w * Jte * Jte.transpose() / e2)
                                : Eigen::Matrix3d(w * r.J.transpose() * r.J);
       JtWe += w * Jte;
-      state.weighted_sq += w * r.e.squaredNorm();
+      state.weighted_sq += w * e2;
       state.weight_sum += w;
     }
     if (iteration == iterations) break;
@@ -186,12 +186,7 @@ std::optional<CircleFit> fitCircleAlongBeams(std::span<const Vector2d> points_m,
   // Covariance of (cx, cy, r): s^2 (J^T W J)^-1, s^2 the weighted variance of m = |e| (near 1
   // when the sigmas are honest).
   const double dof = std::max(1.0, state.weight_sum - 3.0);
-  const Eigen::Matrix3d covariance = (state.weighted_sq / dof) * state.JtWJ.inverse();
-  fit.sigma_radius_m = std::sqrt(std::max(0.0, covariance(2, 2)));
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> center(covariance.topLeftCorner<2, 2>());
-  fit.sigma_center_m = std::sqrt(std::max(0.0, center.eigenvalues().maxCoeff()));
-  fit.arc_deg = arcCoverageDeg(points_m, state.weights, circle.center_m);
-  fit.densest_share = densestShare(points_m, state.weights, circle.center_m);
+  describeFit(fit, points_m, state.weights, (state.weighted_sq / dof) * state.JtWJ.inverse());
   return fit;
 }
 

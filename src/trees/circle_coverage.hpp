@@ -1,9 +1,12 @@
 #pragma once
-// How a fitted circle's inliers spread around it (circle_fit.cpp, beam_circle_fit.cpp).
+// How a fitted circle's inliers spread around it, and its sigmas (circle_fit.cpp,
+// beam_circle_fit.cpp).
 
 #include <Eigen/Core>
 #include <span>
 #include <vector>
+
+#include "taiga/trees/circle_fit.hpp"
 
 namespace taiga::trees {
 
@@ -14,5 +17,11 @@ double arcCoverageDeg(std::span<const Eigen::Vector2d> points_m, const std::vect
 /// Share of the points with a positive weight in the densest 30 deg around `center_m`.
 double densestShare(std::span<const Eigen::Vector2d> points_m, const std::vector<double>& weights,
                     const Eigen::Vector2d& center_m);
+
+/// Sets `fit`'s sigma_radius_m and sigma_center_m (the larger axis of the centre's ellipse) from
+/// the covariance of (cx, cy, r), and its arc_deg and densest_share from the points with a
+/// positive weight around its centre.
+void describeFit(CircleFit& fit, std::span<const Eigen::Vector2d> points_m,
+                 const std::vector<double>& weights, const Eigen::Matrix3d& covariance);
 
 }  // namespace taiga::trees

@@ -123,6 +123,15 @@ double arcCoverageDeg(std::span<const Vector2d> points_m, const std::vector<doub
   return 10.0 * static_cast<double>(std::count(sector.begin(), sector.end(), true));
 }
 
+void describeFit(CircleFit& fit, std::span<const Vector2d> points_m,
+                 const std::vector<double>& weights, const Eigen::Matrix3d& covariance) {
+  fit.sigma_radius_m = std::sqrt(std::max(0.0, covariance(2, 2)));
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> center(covariance.topLeftCorner<2, 2>());
+  fit.sigma_center_m = std::sqrt(std::max(0.0, center.eigenvalues().maxCoeff()));
+  fit.arc_deg = arcCoverageDeg(points_m, weights, fit.center_m);
+  fit.densest_share = densestShare(points_m, weights, fit.center_m);
+}
+
 std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const Vector2d& center_m,
                                       double radius_m, const CircleFitOptions& options) {
   if (points_m.size() < 5) return std::nullopt;
@@ -174,12 +183,7 @@ std::optional<CircleFit> refineCircle(std::span<const Vector2d> points_m, const 
   fit.rms_m = std::sqrt(inlier_sq / static_cast<double>(fit.inliers));
   // Covariance of (cx, cy, r): sigma^2 (J^T W J)^-1 with sigma^2 the weighted residual variance.
   const double dof = std::max(1.0, weight_sum - 3.0);
-  const Eigen::Matrix3d covariance = (weighted_sq / dof) * JtWJ.inverse();
-  fit.sigma_radius_m = std::sqrt(std::max(0.0, covariance(2, 2)));
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> center(covariance.topLeftCorner<2, 2>());
-  fit.sigma_center_m = std::sqrt(std::max(0.0, center.eigenvalues().maxCoeff()));
-  fit.arc_deg = arcCoverageDeg(points_m, weights, circle.center_m);
-  fit.densest_share = densestShare(points_m, weights, circle.center_m);
+  describeFit(fit, points_m, weights, (weighted_sq / dof) * JtWJ.inverse());
   return fit;
 }
 
