@@ -18,11 +18,6 @@ using Matrix23d = Eigen::Matrix<double, 2, 3>;
 
 constexpr double kTukey = 3.0;  // the biweight's cut on the Mahalanobis norm
 
-struct Circle {
-  Vector2d center_m;
-  double radius_m;
-};
-
 // A point's whitened residual (along its beam, across it) and its rows of the Jacobian in
 // (cx, cy, r).
 struct Whitened {

@@ -1,6 +1,6 @@
 #pragma once
-// How a fitted circle's inliers spread around it, and its sigmas (circle_fit.cpp,
-// beam_circle_fit.cpp).
+// The circle that circle_fit.cpp and beam_circle_fit.cpp fit, how its inliers spread around it,
+// and its sigmas.
 
 #include <Eigen/Core>
 #include <span>
@@ -9,6 +9,12 @@
 #include "taiga/trees/circle_fit.hpp"
 
 namespace taiga::trees {
+
+/// A circle in the horizontal plane of a stem section, in the points' frame.
+struct Circle {
+  Eigen::Vector2d center_m;
+  double radius_m = 0.0;
+};
 
 /// Angular coverage of the points with a positive weight around `center_m`, in 10 deg sectors.
 double arcCoverageDeg(std::span<const Eigen::Vector2d> points_m, const std::vector<double>& weights,

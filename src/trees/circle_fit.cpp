@@ -17,11 +17,6 @@ namespace {
 
 using Eigen::Vector2d;
 
-struct Circle {
-  Vector2d center_m;
-  double radius_m = 0.0;
-};
-
 // The circle through three points (the circumcircle), or nothing when they are collinear.
 std::optional<Circle> circleThrough(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
   const Vector2d ab = b - a, ac = c - a;
