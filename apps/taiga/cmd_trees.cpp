@@ -1,6 +1,7 @@
 // taiga trees: the forest inventory of a map (docs/trees.md): ground, DTM, stems, DBH, a tree
 // list and a classified map, from a run directory or any LAS/PLY/PCD cloud.
 #include <fmt/format.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <chrono>
@@ -31,6 +32,7 @@ struct TreesOptions {
   double breast_height_m = 1.3;
   double max_fit_rms_m = 0.045;
   int epsg = 0;
+  int threads = 0;  // 0: one per core
   bool no_map = false;
 };
 
@@ -126,10 +128,15 @@ int runTrees(const TreesOptions& options) {
   io_options.stems.min_dbh_m = options.min_dbh_m;
   io_options.stems.breast_height_m = options.breast_height_m;
   io_options.stems.max_fit_rms_m = options.max_fit_rms_m;
+  io_options.stems.parallel = true;
   // A run's map knows where its sensor was: the DBH fit measures range noise along the beams.
   const KeyframeViewpoints viewpoints = run_dir && options.epsg == 0
                                             ? keyframeViewpoints(input, cloud, offset_m)
                                             : KeyframeViewpoints{};
+  std::optional<tbb::global_control> thread_limit;
+  if (options.threads > 0)
+    thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
+                         static_cast<std::size_t>(options.threads));
   const trees::Inventory inventory = trees::takeInventory(local, io_options, viewpoints.view());
   const std::vector<trees::Stem>& stems = inventory.stems;
 
@@ -226,6 +233,8 @@ Command addTreesCommand(CLI::App& tool) {
                    "The cloud's coordinates are in this projected CRS (trees.csv and "
                    "trees.geojson carry it)")
       ->check(CLI::PositiveNumber);
+  parser->add_option("--threads", options->threads, "Threads for the stem fits, 0: one per core")
+      ->check(CLI::NonNegativeNumber);
   parser->add_flag("--no-map", options->no_map, "Do not write the classified trees_map.las");
   return {parser, [options] { return runTrees(*options); }, options};
 }

@@ -190,8 +190,12 @@ std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
     }
   }
   try {
+    // The recording has ended and the worker has stopped: the fits may take every thread the run
+    // allows (compute.threads).
+    trees::InventoryOptions options;
+    options.stems.parallel = true;
     const trees::Inventory inventory =
-        trees::takeInventory(points_m, {}, trees::Viewpoints{sensors_m, sensor_of});
+        trees::takeInventory(points_m, options, trees::Viewpoints{sensors_m, sensor_of});
     writeCsv(inventory.stems);
     return inventory.stems.size();
   } catch (const InputError& e) {  // no points, or a map too large for one terrain grid

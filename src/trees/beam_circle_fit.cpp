@@ -124,6 +124,34 @@ Irls irls(std::span<const Vector2d> points_m, std::span<const Vector2d> beams, C
   return state;
 }
 
+// The start for the joint fit: the circle of lowest robust cost over radii 0.6-2 times the
+// start's, each with its centre fitted (5 passes), on at most 128 points (every k-th).
+Circle profiledStart(std::span<const Vector2d> points_m, std::span<const Vector2d> beams,
+                     const Circle& start, double sigma_v_m, double sigma_u_m,
+                     const CircleFitOptions& options) {
+  // The sensors' side: a one-sided arc's centre lies behind its surface, so a larger radius moves
+  // it away from the sensors (by the mean beam; near zero for a stem seen all around).
+  Vector2d mean_beam = Vector2d::Zero();
+  for (const Vector2d& v : beams) mean_beam += v;
+  mean_beam /= static_cast<double>(beams.size());
+  const std::size_t stride = (points_m.size() + 127) / 128;
+  std::vector<Vector2d> sample_points, sample_beams;
+  for (std::size_t i = 0; i < points_m.size(); i += stride) {
+    sample_points.push_back(points_m[i]);
+    sample_beams.push_back(beams[i]);
+  }
+  Circle best = start;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (double factor = 0.6; factor < 2.05; factor *= 1.15) {
+    const double r = factor * start.radius_m;
+    if (r < options.min_radius_m || r > options.max_radius_m) continue;
+    Circle circle{start.center_m + (r - start.radius_m) * mean_beam, r};
+    const Irls profile = irls(sample_points, sample_beams, circle, sigma_v_m, sigma_u_m, false, 5);
+    if (profile.cost < best_cost) best_cost = profile.cost, best = circle;
+  }
+  return best;
+}
+
 }  // namespace
 
 std::optional<CircleFit> fitCircleAlongBeams(std::span<const Vector2d> points_m,
@@ -134,30 +162,8 @@ std::optional<CircleFit> fitCircleAlongBeams(std::span<const Vector2d> points_m,
   if (points_m.size() < 5 || beams.size() != points_m.size() || !(start_radius_m > 0.0))
     return std::nullopt;
   const double sigma_v_m = range_sigma_m, sigma_u_m = options.across_beam_sigma_m;
-  // The sensors' side: a one-sided arc's centre lies behind its surface, so a larger radius moves
-  // it away from the sensors (by the mean beam; near zero for a stem seen all around).
-  Vector2d mean_beam = Vector2d::Zero();
-  for (const Vector2d& v : beams) mean_beam += v;
-  mean_beam /= static_cast<double>(beams.size());
-
-  // Profile of the robust cost over the radius, on at most 128 points (every k-th).
-  const std::size_t stride = (points_m.size() + 127) / 128;
-  std::vector<Vector2d> sample_points, sample_beams;
-  for (std::size_t i = 0; i < points_m.size(); i += stride) {
-    sample_points.push_back(points_m[i]);
-    sample_beams.push_back(beams[i]);
-  }
-  Circle best{start_center_m, start_radius_m};
-  double best_cost = std::numeric_limits<double>::infinity();
-  for (double factor = 0.6; factor < 2.05; factor *= 1.15) {
-    const double r = factor * start_radius_m;
-    if (r < options.min_radius_m || r > options.max_radius_m) continue;
-    Circle circle{start_center_m + (r - start_radius_m) * mean_beam, r};
-    const Irls profile = irls(sample_points, sample_beams, circle, sigma_v_m, sigma_u_m, false, 5);
-    if (profile.cost < best_cost) best_cost = profile.cost, best = circle;
-  }
-
-  Circle circle = best;
+  Circle circle = profiledStart(points_m, beams, {start_center_m, start_radius_m}, sigma_v_m,
+                                sigma_u_m, options);
   const Irls state = irls(points_m, beams, circle, sigma_v_m, sigma_u_m, true, 30);
   const auto kept =
       std::count_if(state.weights.begin(), state.weights.end(), [](double w) { return w > 0.0; });

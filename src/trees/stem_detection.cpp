@@ -1,5 +1,6 @@
 #include "taiga/trees/stem_detection.hpp"
 
+#include <tbb/parallel_for.h>
 #include <tsl/robin_map.h>
 
 #include <Eigen/Dense>
@@ -357,10 +358,9 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
                              .inlier_band_m = o.inlier_band_m,
                              .across_beam_sigma_m = o.across_beam_sigma_m};
 
-  std::vector<Stem> candidates;
-  for (std::vector<Vector2d>& cluster : pixelClusters(band)) {
-    // A cluster may hold several stems joined by branches: fit, take the circle's points out,
-    // fit again.
+  // A cluster may hold several stems joined by branches: fit, take the circle's points out,
+  // fit again.
+  const auto measureCluster = [&](std::vector<Vector2d>& cluster, std::vector<Stem>& found) {
     for (int attempt = 0; attempt < 4 && cluster.size() >= 10; ++attempt) {
       const std::optional<CircleFit> seed = fitCircleRobust(cluster, fit);
       if (!seed) break;
@@ -369,10 +369,21 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
       });
       if (std::optional<Stem> stem = measureStem(index, terrain, *seed, o, fit)) {
         stem->height_m = std::max(stem->top_slice_m, treeHeight(canopy, kCanopyPixel_m, *stem, bh));
-        candidates.push_back(*stem);
+        found.push_back(*stem);
       }
     }
+  };
+  std::vector<std::vector<Vector2d>> clusters = pixelClusters(band);
+  std::vector<std::vector<Stem>> found(clusters.size());
+  if (o.parallel) {
+    tbb::parallel_for(std::size_t{0}, clusters.size(),
+                      [&](std::size_t c) { measureCluster(clusters[c], found[c]); });
+  } else {
+    for (std::size_t c = 0; c < clusters.size(); ++c) measureCluster(clusters[c], found[c]);
   }
+  std::vector<Stem> candidates;  // in the clusters' order, whichever thread measured them
+  for (const std::vector<Stem>& stems : found)
+    candidates.insert(candidates.end(), stems.begin(), stems.end());
 
   // One stem per place: of overlapping circles the one with the most points stays.
   std::stable_sort(candidates.begin(), candidates.end(),

@@ -62,6 +62,24 @@ TEST(Stems, EveryStemWithItsDbhLeanAndPositionAndNothingElse) {
   }
 }
 
+// The clusters measured on several threads give the same stems, bit for bit, in the same order.
+TEST(Stems, ParallelClustersGiveTheSameStemsAsOneThread) {
+  const auto points = test::syntheticForest(kStems, 0.005, 3);
+  const TerrainModel terrain = buildTerrainModel(points);
+  StemOptions parallel;
+  parallel.parallel = true;
+  const std::vector<Stem> one = detectStems(points, terrain, {});
+  const std::vector<Stem> many = detectStems(points, terrain, parallel);
+  ASSERT_EQ(one.size(), kStems.size());
+  ASSERT_EQ(many.size(), one.size());
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(many[i].position_m, one[i].position_m) << i;
+    EXPECT_EQ(many[i].dbh_m, one[i].dbh_m) << i;
+    EXPECT_EQ(many[i].dbh_sigma_m, one[i].dbh_sigma_m) << i;
+    EXPECT_EQ(many[i].points, one[i].points) << i;
+  }
+}
+
 TEST(Stems, PointsAreLabelledGroundStemOrOther) {
   const auto points = test::syntheticForest(kStems, 0.005);
   const Inventory inventory = takeInventory(points);

@@ -51,6 +51,10 @@ struct StemOptions {
   /// Nor a ring whose inliers crowd into 30 deg of it: a large ring through one stem's visible
   /// arc and the clutter around it, whose radius means nothing.
   double max_densest_share = 0.6;
+  /// Measure the band's clusters on TBB's threads (the same stems as one thread: each cluster's
+  /// fits are its own). Off by default: the run's tree worker has idle priority, and its fits must
+  /// not run on the threads the odometry waits for.
+  bool parallel = false;
 };
 
 enum class StemQuality : std::uint8_t {
