@@ -1,7 +1,6 @@
 // taiga trees: the forest inventory of a map (docs/trees.md): ground, DTM, stems, DBH, a tree
 // list and a classified map, from a run directory or any LAS/PLY/PCD cloud.
 #include <fmt/format.h>
-#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <chrono>
@@ -18,6 +17,7 @@
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/io/las_writer.hpp"
 #include "taiga/io/trajectory_io.hpp"
+#include "taiga/pipeline/thread_limit.hpp"
 #include "taiga/trees/inventory.hpp"
 #include "taiga/trees/tree_files.hpp"
 
@@ -133,10 +133,7 @@ int runTrees(const TreesOptions& options) {
   const KeyframeViewpoints viewpoints = run_dir && options.epsg == 0
                                             ? keyframeViewpoints(input, cloud, offset_m)
                                             : KeyframeViewpoints{};
-  std::optional<tbb::global_control> thread_limit;
-  if (options.threads > 0)
-    thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
-                         static_cast<std::size_t>(options.threads));
+  const pipeline::ThreadLimit thread_limit(options.threads);
   const trees::Inventory inventory = trees::takeInventory(local, io_options, viewpoints.view());
   const std::vector<trees::Stem>& stems = inventory.stems;
 

@@ -29,6 +29,7 @@
 #include "taiga/mapping/map_export.hpp"
 #include "taiga/pipeline/self_calibration.hpp"
 #include "taiga/pipeline/slam_system.hpp"
+#include "taiga/pipeline/thread_limit.hpp"
 #include "taiga/view/run_view.hpp"
 
 namespace taiga::pipeline {
@@ -225,21 +226,6 @@ void throwIfNoLidarData(const io::ouster::LiveStats& live, const std::string& so
         "sensor's serial number than {} names; the first warning above says which)",
         source, live.lidar_packets, config.metadata));
 }
-
-/// Caps the worker threads of the parallel stages for as long as it lives (compute.threads).
-/// The pipeline's own threads (reading, building the next local map, the mapping back end) are
-/// not capped; docs/architecture.md lists them and what they cost.
-class ThreadLimit {
- public:
-  explicit ThreadLimit(int threads) {
-    if (threads > 0)
-      control_.emplace(tbb::global_control::max_allowed_parallelism,
-                       static_cast<std::size_t>(threads));
-  }
-
- private:
-  std::optional<tbb::global_control> control_;
-};
 
 bool calibratesAtStart(const SystemConfig& config) {
   return config.calibration.at_start && config.odometry.imu_use != "lidar_only";
