@@ -6,11 +6,13 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
 
 #include "taiga/core/hash.hpp"
+#include "taiga/core/percentile.hpp"
 #include "taiga/trees/circle_fit.hpp"
 
 namespace taiga::trees {
@@ -53,6 +55,12 @@ class ColumnIndex {
     const Vector2d beam = points_[i].head<2>() - viewpoints_[i];
     const double length_m = beam.norm();
     return length_m > 0.1 ? Vector2d(beam / length_m) : Vector2d::Zero();
+  }
+
+  /// The horizontal distance from the sensor to point i; NaN when unknown.
+  double rangeOf(std::uint32_t i) const {
+    if (viewpoints_.empty()) return std::numeric_limits<double>::quiet_NaN();
+    return (points_[i].head<2>() - viewpoints_[i]).norm();
   }
 
   /// Calls f(point, i) for the points within `radius_m` of `center_m` with h_lo <= h < h_hi.
@@ -204,6 +212,20 @@ Axis fitAxis(const std::vector<Slice>& slices, double breast_height_m) {
   return axis;
 }
 
+// dr/dh by least squares over the slices from `from_h_m` up (above the butt's swell), kept within
+// [-3 cm, 0] per metre: stems narrow upwards, and a slice series that widens is a branch whorl or
+// clutter, not taper to extrapolate. Zero with fewer than three slices.
+double fitTaper(const std::vector<Slice>& slices, double from_h_m) {
+  double n = 0.0, sh = 0.0, sr = 0.0, shh = 0.0, shr = 0.0;
+  for (const Slice& s : slices) {
+    if (s.h_m < from_h_m) continue;
+    n += 1.0, sh += s.h_m, sr += s.radius_m, shh += s.h_m * s.h_m, shr += s.h_m * s.radius_m;
+  }
+  const double det = n * shh - sh * sh;
+  if (n < 3.0 || !(det > 1e-9)) return 0.0;
+  return std::clamp((n * shr - sh * sr) / det, -0.03, 0.0);
+}
+
 double treeHeight(const CellMap<double>& canopy, double pixel_m, const Stem& stem,
                   double breast_height_m) {
   constexpr double kRadius_m = 0.75;
@@ -235,27 +257,63 @@ bool hollow(const std::vector<Vector2d>& points_m, const CircleFit& fit) {
   return static_cast<double>(inside) <= 0.15 * static_cast<double>(fit.inliers) + 2.0;
 }
 
+// The points of a stem section moved to breast height: by the axis' lean, and radially by the
+// taper (-taper (h - bh)); with their beams and horizontal ranges where the sensor is known.
+struct Section {
+  std::vector<Vector2d> upright_m, beams;
+  std::vector<double> ranges_m;
+};
+Section sectionPoints(const ColumnIndex& index, const Axis& axis, double taper, double radius_m,
+                      double h_lo, double h_hi, double bh) {
+  Section section;
+  const double reach_m = std::max(bh - h_lo, h_hi - bh) * axis.slope.norm();
+  index.forEachNear(axis.at_breast_height, radius_m + 0.15 + reach_m, h_lo, h_hi,
+                    [&](const Vector3d& p, std::uint32_t i) {
+                      const Vector2d q = p.head<2>() - axis.slope * (p.z() - bh);
+                      const Vector2d out = q - axis.at_breast_height;
+                      const double norm = out.norm();
+                      section.upright_m.push_back(
+                          norm > 1e-9 ? Vector2d(q - out / norm * taper * (p.z() - bh)) : q);
+                      section.beams.push_back(index.beamOf(i));
+                      if (const double range_m = index.rangeOf(i); std::isfinite(range_m))
+                        section.ranges_m.push_back(range_m);
+                    });
+  return section;
+}
+
 // Steps 2-5 of the header for one seed circle: the slices along the stem, the axis, the DBH fit
 // and the checks that it is a stem; nothing when it is not.
 std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& terrain,
                                 const CircleFit& seed, const StemOptions& o,
                                 const CircleFitOptions& fit) {
   const double bh = o.breast_height_m;
-  const double band_lo = bh - o.dbh_band_half_m, band_hi = bh + o.dbh_band_half_m;
   const std::vector<Slice> slices = trackStem(index, {bh, seed.center_m, seed.radius_m}, o, fit);
   if (slices.size() < o.min_slices) return std::nullopt;
   const Axis axis = fitAxis(slices, bh);
   const double lean_rad = std::atan(axis.slope.norm());
   if (lean_rad * kDegPerRad > o.max_lean_deg) return std::nullopt;
 
-  // DBH: the band's points with the lean taken out, fitted around the axis; along each point's
-  // beam where the sensor's position is known (fitStemSection).
-  std::vector<Vector2d> upright, beams;
-  index.forEachNear(axis.at_breast_height, seed.radius_m + 0.15 + 0.3 * axis.slope.norm(), band_lo,
-                    band_hi, [&](const Vector3d& p, std::uint32_t i) {
-                      upright.push_back(p.head<2>() - axis.slope * (p.z() - bh));
-                      beams.push_back(index.beamOf(i));
-                    });
+  // DBH: the points of the band around breast height, moved there by the axis' lean and the
+  // slices' taper, fitted around the axis; along each point's beam where the sensor's position is
+  // known (fitStemSection). A band with few points (a far stem: its radius at 1.0-1.6 m alone is
+  // weakly determined) is widened in steps towards the section StemOptions::dbh_section_*, within
+  // the slices the stem was tracked through (BENCHMARK.md, "Session 61").
+  const auto [lowest, highest] = std::minmax_element(
+      slices.begin(), slices.end(), [](const Slice& a, const Slice& b) { return a.h_m < b.h_m; });
+  const double band_lo = bh - o.dbh_band_half_m, band_hi = bh + o.dbh_band_half_m;
+  const double tracked_lo = std::min(band_lo, lowest->h_m - 0.5 * o.slice_m);
+  const double tracked_hi = std::max(band_hi, highest->h_m + 0.5 * o.slice_m);
+  const double taper = fitTaper(slices, band_lo);
+  Section section;
+  for (const double share : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    const double lo = band_lo - share * (o.dbh_section_below_m - o.dbh_band_half_m);
+    const double hi = band_hi + share * (o.dbh_section_above_m - o.dbh_band_half_m);
+    section = sectionPoints(index, axis, taper, seed.radius_m, std::max(lo, tracked_lo),
+                            std::min(hi, tracked_hi), bh);
+    if (section.upright_m.size() >= o.dbh_band_enough_points) break;
+  }
+  const std::vector<Vector2d>& upright = section.upright_m;
+  const std::vector<Vector2d>& beams = section.beams;
   const double max_rms_m =
       slices.size() >= o.long_stem_slices ? o.max_fit_rms_m : 2.0 / 3.0 * o.max_fit_rms_m;
   const auto isStem = [&](const std::optional<CircleFit>& f) {
@@ -271,11 +329,12 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
       dbh_fit->sigma_radius_m, viewJackknifeSigmaRadius(upright, beams, *dbh_fit,
                                                         axis.at_breast_height, seed.radius_m, fit));
   // Along the beams a one-sided arc's radius can be left undetermined (a flat profile out to
-  // large circles): when its sigma is over a fifth of it, the fit across the surface, whose bias
-  // is small and bounded, with its own jackknife (views blocked by azimuth around the centre).
-  // On the harvester's strip road (one-sided views) the along-beam fit alone made 23 cm stems
-  // 39 cm (BENCHMARK.md, "Session 58").
-  if (dbh_fit->along_beams && sigma_radius_m > 0.2 * dbh_fit->radius_m) {
+  // large circles): when its sigma is over half of it, the fit across the surface, whose bias is
+  // bounded, with its own jackknife (views blocked by azimuth around the centre). On the
+  // harvester's strip road (one-sided views) the along-beam fit alone made 23 cm stems 39 cm
+  // (BENCHMARK.md, "Session 58"); but on a far noisy crescent the fit across is 2-4 cm small in
+  // DBH, so a fifth, as before session 61, gave that bias to a third of the far stems.
+  if (dbh_fit->along_beams && sigma_radius_m > 0.5 * dbh_fit->radius_m) {
     dbh_fit = fitStemSection(upright, axis.at_breast_height, seed.radius_m, fit);
     if (!isStem(dbh_fit)) return std::nullopt;
     sigma_radius_m = std::max(
@@ -286,7 +345,10 @@ std::optional<Stem> measureStem(const ColumnIndex& index, const TerrainModel& te
   Stem stem;
   stem.dbh_m = 2.0 * dbh_fit->radius_m * lean_scale;
   if (stem.dbh_m < o.min_dbh_m || stem.dbh_m > o.max_dbh_m) return std::nullopt;
-  stem.dbh_sigma_m = 2.0 * sigma_radius_m * lean_scale;
+  // The map's share, common to all views of the stem (StemOptions::dbh_sigma_per_range).
+  const double map_sigma_m =
+      section.ranges_m.empty() ? 0.0 : o.dbh_sigma_per_range * percentile(section.ranges_m, 50.0);
+  stem.dbh_sigma_m = std::hypot(2.0 * sigma_radius_m * lean_scale, map_sigma_m);
   stem.ground_z_m = terrain.heightAt(dbh_fit->center_m.x(), dbh_fit->center_m.y());
   stem.position_m = Vector3d(dbh_fit->center_m.x(), dbh_fit->center_m.y(), stem.ground_z_m + bh);
   stem.axis_slope = axis.slope;

@@ -15,6 +15,8 @@ struct SyntheticStem {
   double dbh_m;
   double lean_x = 0.0;  ///< d(x)/dh of the axis
   double min_angle_rad = -std::numbers::pi, max_angle_rad = std::numbers::pi;  ///< visible arc
+  double taper = 0.0;        ///< d(radius)/dh, the radius being dbh_m / 2 at 1.3 m
+  int points_per_ring = 60;  ///< every 2 cm of height
 };
 
 inline double groundZ(double x, double y) { return 0.3 * x + 0.1 * y; }  // a 30 % slope
@@ -31,9 +33,9 @@ inline std::vector<Eigen::Vector3d> syntheticForest(const std::vector<SyntheticS
   for (const SyntheticStem& s : stems) {
     const double ground = groundZ(s.base_xy.x(), s.base_xy.y());
     for (double h = 0.0; h < 6.0; h += 0.02)
-      for (int k = 0; k < 60; ++k) {
+      for (int k = 0; k < s.points_per_ring; ++k) {
         const double a = s.min_angle_rad + (s.max_angle_rad - s.min_angle_rad) * u(rng);
-        const double r = 0.5 * s.dbh_m + noise(rng);
+        const double r = 0.5 * s.dbh_m + s.taper * (h - 1.3) + noise(rng);
         points.emplace_back(s.base_xy.x() + s.lean_x * h + r * std::cos(a),
                             s.base_xy.y() + r * std::sin(a), ground + h);
       }

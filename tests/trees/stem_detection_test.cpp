@@ -171,6 +171,52 @@ TEST(Stems, RangeNoiseOnAOneSidedStemLeavesItsDbhUnbiasedWhenTheViewpointsAreGiv
   }
 }
 
+// A stem with few points per metre (a far one: one per ring every 2 cm, 1 cm of noise): its band
+// at 1.0-1.6 m holds 30 points, so the fit is widened towards 0.8-2.8 m with the taper taken out.
+double sparseStemDbh(double taper, unsigned seed, std::size_t enough_points) {
+  const test::SyntheticStem stem{
+      .base_xy = {0.0, 0.0}, .dbh_m = 0.2, .taper = taper, .points_per_ring = 1};
+  InventoryOptions options;
+  options.stems.dbh_band_enough_points = enough_points;
+  const Inventory inventory =
+      takeInventory(test::syntheticForest({stem}, 0.01, seed, false), options);
+  EXPECT_EQ(inventory.stems.size(), 1u) << seed;
+  return inventory.stems.empty() ? 0.0 : inventory.stems.front().dbh_m;
+}
+
+TEST(Stems, AFewPointsPerMetreWidenTheDbhBandAndItsErrorShrinks) {
+  double band_sq = 0.0, widened_sq = 0.0;
+  for (unsigned seed = 1; seed <= 16; ++seed) {
+    const double band_m = sparseStemDbh(0.0, seed, 0), widened_m = sparseStemDbh(0.0, seed, 400);
+    band_sq += std::pow(band_m - 0.2, 2);
+    widened_sq += std::pow(widened_m - 0.2, 2);
+  }
+  // 3.3x the points: the error should shrink by about 1.8x (measured: 5.2 -> 3.1 mm).
+  EXPECT_LT(std::sqrt(widened_sq / 16.0), 0.75 * std::sqrt(band_sq / 16.0));
+  EXPECT_LT(std::sqrt(widened_sq / 16.0), 0.004);
+}
+
+TEST(Stems, TheWidenedBandTakesTheTaperOutOfTheDbh) {
+  // 2 cm of radius per metre: untapered, a section reaching 2.8 m would make the DBH about 2 cm
+  // small (its points' mean height is near 1.8 m).
+  double sum = 0.0;
+  for (unsigned seed = 1; seed <= 4; ++seed) sum += sparseStemDbh(-0.02, seed, 400) - 0.2;
+  EXPECT_NEAR(sum / 4.0, 0.0, 0.004);
+}
+
+TEST(Stems, TheDbhSigmaOfAStemSeenFromItsSensorHoldsTheMapsShareByRange) {
+  // 2 mm of range noise: the fit's own sigma is a few mm; seen from 8 m, the map's share
+  // (StemOptions::dbh_sigma_per_range, 1 mm per metre) is 8 mm. A cloud without sensors has none.
+  const OneSidedStem stem = oneSidedStem(0.002, 1);
+  const Inventory with =
+      takeInventory(stem.points_m, {}, Viewpoints{stem.sensor_m, stem.viewpoint_of});
+  const Inventory without = takeInventory(stem.points_m);
+  ASSERT_EQ(with.stems.size(), 1u);
+  ASSERT_EQ(without.stems.size(), 1u);
+  EXPECT_GE(with.stems.front().dbh_sigma_m, 0.0079);
+  EXPECT_LT(without.stems.front().dbh_sigma_m, 0.005);
+}
+
 TEST(Stems, ACloudWithoutStemsGivesNone) {
   const auto points = test::syntheticForest({}, 0.005);
   EXPECT_TRUE(takeInventory(points).stems.empty());

@@ -31,7 +31,21 @@ namespace taiga::trees {
 
 struct StemOptions {
   double breast_height_m = 1.3;
-  double dbh_band_half_m = 0.3;  ///< DBH from the points breast_height +- this
+  /// Stems are sought in the points breast_height +- this, and their DBH fitted to that band's
+  /// points, each moved to breast height by the stem's lean and taper. A band with fewer than
+  /// dbh_band_enough_points points is widened in steps up to the section from breast_height -
+  /// dbh_section_below_m to + dbh_section_above_m (within the slices the stem was tracked through):
+  /// a far stem has few points per metre.
+  double dbh_band_half_m = 0.3;
+  std::size_t dbh_band_enough_points = 400;
+  double dbh_section_below_m = 0.5;
+  double dbh_section_above_m = 1.5;
+  /// Added in quadrature to the DBH 1-sigma of a stem whose points' sensors are known, times the
+  /// median horizontal range they were seen from: the map's placement error common to all views
+  /// of a stem, which no resampling of its views can see (a run's scans are 0.05-0.1 % too large
+  /// for their trajectory, issue 25; the DBH bias grows by about 1 mm per metre of range:
+  /// BENCHMARK.md, "Session 61").
+  double dbh_sigma_per_range = 0.001;
   double min_dbh_m = 0.07;       ///< thinner stems are not reported (saplings, shrubs)
   double max_dbh_m = 1.2;
   double slice_m = 0.3;
