@@ -18,6 +18,11 @@
 
 namespace taiga::app {
 namespace {
+
+// alignWithOrientations' lever: an orientation counts as much as positions this far apart. Against
+// a walk's metres of extent that leaves Umeyama's rotation as it is; along a straight path it is
+// the only thing that fixes the rotation about it.
+constexpr double kMapAlignmentLever_m = 0.1;
 struct EvalOptions {
   std::string estimate, reference;
   std::string align = "se3";
@@ -78,6 +83,14 @@ int runEval(const EvalOptions& options) {
     throw InputError(
         fmt::format("{} against {}: {}", options.estimate, options.reference, e.what()));
   }
+  // The map and its trees hang on the trajectory at a lever arm of metres: with se3, their
+  // alignment takes the orientations too, so that a short, straight path (the harvester's strip
+  // road) does not leave the rotation about it to chance (eval/alignment.hpp).
+  const eval::AlignmentTransform map_transform =
+      report.result.alignment == eval::Alignment::kSe3
+          ? eval::alignWithOrientations(report.result.pairs.est, report.result.pairs.ref,
+                                        kMapAlignmentLever_m)
+          : report.result.transform;
   if (!options.map.empty() || !options.scene.empty()) {
     if (options.map.empty() || options.scene.empty())
       throw InputError(
@@ -85,7 +98,7 @@ int runEval(const EvalOptions& options) {
           "scene it is scored against");
     report.map_file = options.map;
     report.scene_dir = options.scene;
-    report.map_sharpness = mapSharpness(options, report.result.transform);
+    report.map_sharpness = mapSharpness(options, map_transform);
   }
   if (!options.trees.empty() || !options.ref_trees.empty()) {
     if (options.trees.empty() || options.ref_trees.empty())
@@ -95,8 +108,8 @@ int runEval(const EvalOptions& options) {
     std::vector<Eigen::Vector3d> path_m;
     for (const StampedPose& pose : ref) path_m.push_back(pose.pose.translation());
     report.trees = eval::evaluateTrees(trees::readTreesCsv(options.trees),
-                                       trees::readTreesCsv(options.ref_trees),
-                                       report.result.transform, path_m, options.tree_options);
+                                       trees::readTreesCsv(options.ref_trees), map_transform,
+                                       path_m, options.tree_options);
   }
   if (!options.scans.empty()) {
     report.scans_file = options.scans;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/SVD>
 #include <cassert>
 
 #include "taiga/core/errors.hpp"
@@ -66,6 +67,29 @@ AlignmentTransform computeAlignment(const std::vector<StampedPose>& est,
       break;
   }
   return {};
+}
+
+AlignmentTransform alignWithOrientations(const std::vector<StampedPose>& est,
+                                         const std::vector<StampedPose>& ref, double lever_m) {
+  assert(est.size() == ref.size() && !est.empty());
+  Eigen::Vector3d x_mean = Eigen::Vector3d::Zero(), y_mean = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < est.size(); ++i) {
+    x_mean += est[i].pose.translation();
+    y_mean += ref[i].pose.translation();
+  }
+  x_mean /= static_cast<double>(est.size());
+  y_mean /= static_cast<double>(ref.size());
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < est.size(); ++i) {
+    M += (ref[i].pose.translation() - y_mean) * (est[i].pose.translation() - x_mean).transpose();
+    M += lever_m * lever_m * ref[i].pose.rotation().matrix() *
+         est[i].pose.rotation().matrix().transpose();
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
+  return {lie::SE3(lie::SO3::fromMatrix(R), y_mean - R * x_mean), 1.0};
 }
 
 std::vector<StampedPose> applyAlignment(const std::vector<StampedPose>& poses,

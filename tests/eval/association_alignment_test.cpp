@@ -147,6 +147,39 @@ TEST(Alignment, Sim3ScalesPositionsBeforeTheRigidTransform) {
   EXPECT_TRUE(none.T_ref_est.matrix().isIdentity(0.0));
 }
 
+TEST(Alignment, WithOrientationsAStraightPathsRollIsTheOrientationsAndACurvedOneUmeyamas) {
+  // A straight path of 2 m whose positions wobble by a millimetre across it (the harvester's
+  // strip road): Umeyama leaves the rotation about it to the wobble. The estimate is the truth
+  // rolled by 5 deg about the path (x) and moved, with 3 mm of noise on its positions.
+  std::vector<StampedPose> ref;
+  for (int i = 0; i < 50; ++i)
+    ref.push_back({0.1 * i, lie::SE3(lie::SO3::fromAxisAngle({0.0, 0.0, 1.0}, 0.02 * i),
+                                     {0.04 * i, 0.001 * std::sin(i), 0.001 * std::cos(2.0 * i)})});
+  const lie::SE3 T_est_ref(lie::SO3::fromAxisAngle({1.0, 0.0, 0.0}, 5.0 * std::numbers::pi / 180.0),
+                           {3.0, -1.0, 0.5});
+  std::vector<StampedPose> est = test::transformed(T_est_ref, ref);
+  for (std::size_t i = 0; i < est.size(); ++i)
+    est[i].pose = lie::SE3(
+        est[i].pose.rotation(),
+        est[i].pose.translation() +
+            0.003 * Eigen::Vector3d(std::cos(3.0 * i), std::sin(5.0 * i), std::sin(7.0 * i)));
+  const double umeyama_error_deg =
+      (computeAlignment(est, ref, Alignment::kSe3).T_ref_est * T_est_ref).rotation().angle() *
+      180.0 / std::numbers::pi;
+  const double with_error_deg =
+      (alignWithOrientations(est, ref, 0.1).T_ref_est * T_est_ref).rotation().angle() * 180.0 /
+      std::numbers::pi;
+  EXPECT_GT(umeyama_error_deg, 1.0) << "the degeneracy this test is about has gone away";
+  EXPECT_LT(with_error_deg, 0.05);
+
+  // On a curved path the positions decide, and both agree.
+  const std::vector<StampedPose> curved = test::curvedPath(30);
+  const std::vector<StampedPose> moved = test::transformed(T_est_ref, curved);
+  const lie::SE3 a = computeAlignment(moved, curved, Alignment::kSe3).T_ref_est;
+  const lie::SE3 b = alignWithOrientations(moved, curved, 0.1).T_ref_est;
+  EXPECT_TRUE(a.matrix().isApprox(b.matrix(), 1e-9));
+}
+
 TEST(Alignment, NamesParseAndBadNamesAreRefused) {
   EXPECT_EQ(parseAlignment("sim3"), Alignment::kSim3);
   EXPECT_EQ(alignmentName(parseAlignment("origin")), "origin");

@@ -47,6 +47,17 @@ AlignmentTransform umeyama(const std::vector<Eigen::Vector3d>& source,
 AlignmentTransform computeAlignment(const std::vector<StampedPose>& est,
                                     const std::vector<StampedPose>& ref, Alignment alignment);
 
+/// The se3 alignment for what hangs on the trajectory (its map, its trees), which a rotation
+/// error moves by its lever arm: Umeyama's cost on the positions plus lever_m^2 times the
+/// orientations' chordal distance, sum_i |y_i - R x_i - t|^2 + lever_m^2 |R_ref_i - R R_est_i|_F^2.
+/// Both terms are linear in R, so R is Kabsch's on M = sum_i (y_i - y_mean)(x_i - x_mean)^T +
+/// lever_m^2 sum_i R_ref_i R_est_i^T (M = U S V^T, R = U diag(1, 1, det(U V^T)) V^T), and t =
+/// y_mean - R x_mean. With lever_m small against the path's extent this is Umeyama's alignment
+/// where the positions determine the rotation; where they do not (a short, straight path: the
+/// rotation about it), the orientations do. Pairs of equal size, not empty.
+AlignmentTransform alignWithOrientations(const std::vector<StampedPose>& est,
+                                         const std::vector<StampedPose>& ref, double lever_m);
+
 /// Applies `transform` to every pose: positions scaled, then the rigid transform on the left.
 std::vector<StampedPose> applyAlignment(const std::vector<StampedPose>& poses,
                                         const AlignmentTransform& transform);
