@@ -54,6 +54,7 @@ OnlineTrees::~OnlineTrees() {
     std::lock_guard lock(mutex_);
     stopping_ = true;
   }
+  stop_.request_stop();  // the update in flight skips its remaining clusters
   wake_.notify_all();
   if (worker_.joinable()) worker_.join();
 }
@@ -144,8 +145,11 @@ void OnlineTrees::update(const std::vector<Keyframe>& fresh) {
     }
   }
   if (points_m.empty()) return;
+  trees::InventoryOptions options;
+  options.stems.stop = stop_.get_token();
   const trees::Inventory inventory =
-      trees::takeInventory(points_m, {}, trees::Viewpoints{sensors_m, sensor_of});
+      trees::takeInventory(points_m, options, trees::Viewpoints{sensors_m, sensor_of});
+  if (stop_.stop_requested()) return;  // a part of the region's stems; finish() redoes them all
 
   for (const trees::Stem& stem : inventory.stems) {
     const bool seen_here = nearestFresh(stem.position_m) <= kSeen_m;
@@ -175,6 +179,7 @@ std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
     jobs_.clear();
     stopping_ = true;
   }
+  stop_.request_stop();  // the update in flight skips its remaining clusters
   wake_.notify_all();
   if (worker_.joinable()) worker_.join();
   // The final list: one inventory of the whole map on the graph's final poses, the same as

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <functional>
 #include <mutex>
+#include <stop_token>
 #include <thread>
 #include <vector>
 
@@ -71,6 +72,7 @@ class OnlineTrees final : public SlamObserver {
   std::condition_variable wake_;
   std::deque<std::vector<Keyframe>> jobs_;
   bool stopping_ = false;
+  std::stop_source stop_;  ///< finish() cuts the update in flight short: the final pass covers it
   double work_s_ = 0.0;
   std::size_t updates_ = 0;
   std::thread worker_;

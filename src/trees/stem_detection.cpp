@@ -423,6 +423,7 @@ std::vector<Stem> detectStems(std::span<const Vector3d> points_m, const TerrainM
   // A cluster may hold several stems joined by branches: fit, take the circle's points out,
   // fit again.
   const auto measureCluster = [&](std::vector<Vector2d>& cluster, std::vector<Stem>& found) {
+    if (o.stop.stop_requested()) return;
     for (int attempt = 0; attempt < 4 && cluster.size() >= 10; ++attempt) {
       const std::optional<CircleFit> seed = fitCircleRobust(cluster, fit);
       if (!seed) break;

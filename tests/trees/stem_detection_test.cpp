@@ -80,6 +80,19 @@ TEST(Stems, ParallelClustersGiveTheSameStemsAsOneThread) {
   }
 }
 
+// A stop requested skips the clusters not yet measured (the online tree map's update when the run
+// ends): requested before, none is measured; never requested, all are.
+TEST(Stems, AStopRequestedSkipsTheClustersNotYetMeasured) {
+  const auto points = test::syntheticForest(kStems, 0.005, 3);
+  const TerrainModel terrain = buildTerrainModel(points);
+  std::stop_source stop;
+  StemOptions options;
+  options.stop = stop.get_token();
+  EXPECT_EQ(detectStems(points, terrain, options).size(), kStems.size());
+  stop.request_stop();
+  EXPECT_TRUE(detectStems(points, terrain, options).empty());
+}
+
 TEST(Stems, PointsAreLabelledGroundStemOrOther) {
   const auto points = test::syntheticForest(kStems, 0.005);
   const Inventory inventory = takeInventory(points);

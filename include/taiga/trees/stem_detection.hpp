@@ -22,6 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,10 @@ struct StemOptions {
   /// fits are its own). Off by default: the run's tree worker has idle priority, and its fits must
   /// not run on the threads the odometry waits for.
   bool parallel = false;
+  /// Once a stop is requested, the clusters not yet measured are skipped: the stems returned are
+  /// then a part of the cloud's, for a caller that no longer wants them (the online tree map's
+  /// update when the run ends, whose region the final inventory covers anyway).
+  std::stop_token stop;
 };
 
 enum class StemQuality : std::uint8_t {
