@@ -4,13 +4,13 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
 #include "taiga/core/errors.hpp"
 #include "taiga/core/percentile.hpp"
 #include "taiga/imu/readings.hpp"
+#include "taiga/lie/umeyama.hpp"
 
 namespace taiga::calib {
 namespace {
@@ -91,10 +91,7 @@ State alignAtOffset(const Problem& p, double offset_s, double* rms_radps) {
     Matrix3d H = Matrix3d::Zero();
     for (std::size_t k = 0; k < p.size(); ++k)
       H += (g[k] - s.bias_radps * p.duration(k)) * p.increment(k).theta_body_rad.transpose();
-    const Eigen::JacobiSVD<Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Matrix3d D = Matrix3d::Identity();
-    D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-    s.R_c = svd.matrixU() * D * svd.matrixV().transpose();
+    s.R_c = lie::kabschRotation(H);
     Vector3d num = Vector3d::Zero();
     double den = 0.0;
     for (std::size_t k = 0; k < p.size(); ++k) {

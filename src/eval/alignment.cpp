@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <Eigen/SVD>
 #include <cassert>
 
 #include "taiga/core/errors.hpp"
@@ -85,10 +84,7 @@ AlignmentTransform alignWithOrientations(const std::vector<StampedPose>& est,
     M += lever_m * lever_m * ref[i].pose.rotation().matrix() *
          est[i].pose.rotation().matrix().transpose();
   }
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-  const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
+  const Eigen::Matrix3d R = lie::kabschRotation(M);
   return {lie::SE3(lie::SO3::fromMatrix(R), y_mean - R * x_mean), 1.0};
 }
 

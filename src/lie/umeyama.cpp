@@ -29,6 +29,13 @@ int crossCovarianceRank(std::span<const Vector3> source, std::span<const Vector3
   return static_cast<int>((d.array() > std::numeric_limits<double>::epsilon()).count());
 }
 
+Matrix3 kabschRotation(const Matrix3& M) {
+  const Eigen::JacobiSVD<Matrix3> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Matrix3 D = Matrix3::Identity();
+  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  return svd.matrixU() * D * svd.matrixV().transpose();
+}
+
 Similarity umeyama(std::span<const Vector3> source, std::span<const Vector3> target,
                    bool with_scale) {
   assert(source.size() == target.size() && !source.empty());

@@ -24,6 +24,11 @@ struct Similarity {
 /// not determined and umeyama() returns an arbitrary one. 0 for empty sets.
 int crossCovarianceRank(std::span<const Vector3> source, std::span<const Vector3> target);
 
+/// Kabsch's step: the rotation R maximising trace(R^T M), i.e. of the least-squares problems whose
+/// cost is -2 trace(R^T M) plus constants. M = U S V^T, R = U diag(1, 1, det(U V^T)) V^T (a
+/// rotation, never a reflection).
+Matrix3 kabschRotation(const Matrix3& M);
+
 /// The least-squares similarity (with_scale) or rigid transform (scale 1) taking source[i] onto
 /// target[i]; the sets have the same size and are not empty.
 Similarity umeyama(std::span<const Vector3> source, std::span<const Vector3> target,
