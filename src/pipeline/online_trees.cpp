@@ -49,9 +49,13 @@ OnlineTrees::OnlineTrees(const mapping::KeyframeStore& store, std::filesystem::p
       on_list_(std::move(on_list)),
       worker_([this] { run(); }) {}
 
-OnlineTrees::~OnlineTrees() {
+OnlineTrees::~OnlineTrees() { stopWorker(); }
+
+void OnlineTrees::stopWorker() {
   {
     std::lock_guard lock(mutex_);
+    pending_.clear();
+    jobs_.clear();
     stopping_ = true;
   }
   stop_.request_stop();  // the update in flight skips its remaining clusters
@@ -173,15 +177,7 @@ void OnlineTrees::writeCsv(const std::vector<trees::Stem>& stems) const {
 }
 
 std::size_t OnlineTrees::finish(const std::vector<lie::SE3>& final_T_map_body) {
-  {
-    std::lock_guard lock(mutex_);
-    pending_.clear();  // the final pass below covers them
-    jobs_.clear();
-    stopping_ = true;
-  }
-  stop_.request_stop();  // the update in flight skips its remaining clusters
-  wake_.notify_all();
-  if (worker_.joinable()) worker_.join();
+  stopWorker();  // the final pass below covers what it had left
   // The final list: one inventory of the whole map on the graph's final poses, the same as
   // `taiga trees RUN` on map.las. The incremental list saw each stem only from the keyframes
   // around it at the time, on live poses (docs/trees.md, "Online").

@@ -58,6 +58,9 @@ class OnlineTrees final : public SlamObserver {
     lie::SE3 T_map_body;  ///< live pose when it was added
   };
   void run();
+  /// Ends the worker: queued updates dropped, the one in flight cut short (after a stop an update
+  /// writes nothing), the thread joined.
+  void stopWorker();
   void update(const std::vector<Keyframe>& fresh);
   void writeCsv(const std::vector<trees::Stem>& stems) const;
 
