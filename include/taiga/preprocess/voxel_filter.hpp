@@ -15,15 +15,23 @@ namespace taiga::preprocess {
 enum class VoxelRepresentative {
   centroid,  ///< their mean: least noisy, but inside a curved surface (a stem's arc, a hummock)
   measured,  ///< the return nearest to that mean: on the surface (docs/registration.md, "Bias")
+  /// The return whose direction from the sensor is nearest the mean's: on the surface, and
+  /// chosen without regard to its range, so its range noise is not selected for. (`measured`
+  /// prefers returns whose noise put them behind the surface, toward the mean inside a convex
+  /// one.)
+  bearing,
 };
 
-/// One point per voxel of edge `voxel_size_m` (> 0), the centroid or the measured return nearest
-/// to it; the other channels (time, intensity, ring, column) are taken from that nearest return.
-/// Points with non-finite coordinates are dropped.
+/// One point per voxel of edge `voxel_size_m` (> 0), the centroid or a measured return near it;
+/// the other channels (time, intensity, ring, column) are taken from the return nearest the
+/// centroid (`bearing`: from the return it picks). `sensor` is the sensor's position in the
+/// cloud's frame (for `bearing`). Points with non-finite coordinates are dropped.
 PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m,
-                       VoxelRepresentative representative = VoxelRepresentative::centroid);
+                       VoxelRepresentative representative = VoxelRepresentative::centroid,
+                       const Eigen::Vector3d& sensor = Eigen::Vector3d::Zero());
 
-/// "centroid" or "measured" (OdometryConfig::voxel_point); throws std::invalid_argument else.
+/// "centroid", "measured" or "bearing" (OdometryConfig::voxel_point); throws std::invalid_argument
+/// else.
 VoxelRepresentative voxelRepresentative(std::string_view name);
 
 }  // namespace taiga::preprocess
