@@ -1,7 +1,9 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "taiga/registration/ndt.hpp"
 
@@ -47,12 +49,58 @@ NdtConstants ndtConstants(double resolution_m, double outlier_ratio) {
   return k;
 }
 
+namespace {
+
+/// A cell whose own section did not make it a stem cell.
+struct NotStem {
+  std::size_t cell;
+  const CellMoments* moments;
+  double min_variance_m2;  ///< the floor of its Gaussian's eigenvalues
+};
+
+// A stem whose axis runs near a cell border leaves each cell a short arc that fails the gates,
+// and those cells kept most of the remaining bias (docs/registration.md, "Local-map points on
+// the surface, and stems across cell borders"). Each such cell tries the four 2 x 2 blocks of cells
+// it belongs to and takes the circle of the block with the most points that passes.
+void fitStemsAcrossBorders(std::span<const CellMoments> moments, std::span<const NotStem> not_stems,
+                           double resolution_m, std::vector<NdtCell>& cells) {
+  if (not_stems.empty()) return;
+  std::vector<VoxelKey> keys;
+  keys.reserve(moments.size());
+  for (const CellMoments& m : moments) keys.push_back(m.key);
+  const VoxelIndex index(keys);
+  for (const NotStem& own : not_stems) {
+    std::size_t best_count = 0;
+    for (const VoxelKey corner :
+         {VoxelKey{0}, -kVoxelStepX, -kVoxelStepY, -kVoxelStepX - kVoxelStepY}) {
+      const CellMoments* block[4];
+      std::size_t n = 0, count = 0;
+      for (const VoxelKey step :
+           {VoxelKey{0}, kVoxelStepX, kVoxelStepY, kVoxelStepX + kVoxelStepY}) {
+        if (const std::int32_t j = index.find(own.moments->key + corner + step); j >= 0) {
+          block[n++] = &moments[j];
+          count += moments[j].count;
+        }
+      }
+      if (n < 2 || count <= best_count) continue;
+      if (fitStemSectionAcross(*own.moments, std::span(block, n), resolution_m, own.min_variance_m2,
+                               cells[own.cell])) {
+        best_count = count;
+      }
+    }
+  }
+}
+
+}  // namespace
+
 NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
     : resolution_m_(stats.resolution_m()), inverse_resolution_(1.0 / stats.resolution_m()) {
   if (cells.stem_cells && !stats.circleMoments()) {
     throw std::logic_error("NdtTarget: stem cells need statistics with circle moments");
   }
-  for (const CellMoments& m : stats.moments(cells.min_points_per_cell)) {
+  const std::vector<CellMoments> moments = stats.moments(cells.min_points_per_cell);
+  std::vector<NotStem> not_stems;
+  for (const CellMoments& m : moments) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(m.covariance);
     Eigen::Vector3d lambda = solver.eigenvalues();
     const double lambda_max = lambda.maxCoeff();
@@ -69,13 +117,17 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
     cell.count = m.count;
     cell.covariance = V * lambda.asDiagonal() * V.transpose();
     cell.inverse_covariance = V * lambda.cwiseInverse().asDiagonal() * V.transpose();
-    if (cells.stem_cells) {
-      fitStemSection(m, resolution_m_, cells.min_eigenvalue_ratio * lambda_max, cell);
+    const double min_variance_m2 = cells.min_eigenvalue_ratio * lambda_max;
+    if (cells.stem_cells && !fitStemSection(m, resolution_m_, min_variance_m2, cell)) {
+      not_stems.push_back({cells_.size(), &m, min_variance_m2});
     }
     cells_.push_back(cell);
     keys_.push_back(m.key);
   }
   index_ = VoxelIndex(keys_);
+  if (cells.stem_cells_across_borders) {
+    fitStemsAcrossBorders(moments, not_stems, resolution_m_, cells_);
+  }
 }
 
 NdtTarget NdtTarget::fromPoints(std::span<const Eigen::Vector3d> points, double resolution_m,
@@ -90,15 +142,10 @@ int NdtTarget::neighboursOf(VoxelKey key, NeighbourSearch search, const NdtCell*
   int n = 0;
   if (const std::int32_t i = index_.find(key); i >= 0) out[n++] = &cells_[i];
   if (search == NeighbourSearch::kDirect7) {
-    // Packed axes: x in bits 42.., y in 21.., z in 0..; a neighbour differs by +-1 on one axis.
-    // Keys are away from the axis limits by construction of voxelOf (|i| < 1e6 < 2^20 - 1).
-    constexpr std::int64_t kSteps[6] = {std::int64_t{1} << 42,
-                                        -(std::int64_t{1} << 42),
-                                        std::int64_t{1} << 21,
-                                        -(std::int64_t{1} << 21),
-                                        1,
-                                        -1};
-    for (std::int64_t step : kSteps) {
+    // A face neighbour differs by +-1 on one axis.
+    constexpr VoxelKey kSteps[6] = {kVoxelStepX,  -kVoxelStepX, kVoxelStepY,
+                                    -kVoxelStepY, kVoxelStepZ,  -kVoxelStepZ};
+    for (const VoxelKey step : kSteps) {
       if (const std::int32_t i = index_.find(key + step); i >= 0) out[n++] = &cells_[i];
     }
   }

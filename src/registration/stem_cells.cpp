@@ -5,6 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <span>
 
 #include "taiga/registration/ndt.hpp"
 
@@ -53,39 +55,129 @@ bool taubin(double xx, double yy, double xy, double xw, double yw, double ww, Ci
   return std::isfinite(out.radius_m) && std::isfinite(out.residual_variance_m2);
 }
 
+// The central moments (1/n) of the union of cells, from each cell's count, mean, covariance
+// and circle moments by the parallel-axis rules to the fourth order. With a cell's horizontal
+// offset a from a common origin, its points' d about its mean (E[d] = 0, E[d d^T] = P,
+// E[d w_d] = t, E[w_d^2] = q) and x = a + d, w = |x|^2:
+//   E[x w]   = a |a|^2 + a tr P + 2 P a + t
+//   E[w^2]   = |a|^4 + 4 a^T P a + 2 |a|^2 tr P + 4 a.t + q,
+// the same rules read backwards about the union's mean give its central moments.
+struct Raw {
+  Eigen::Vector2d xw;
+  double ww;
+};
+Raw aboutOffset(const Eigen::Vector2d& a, const Eigen::Matrix2d& P, const Eigen::Vector2d& t,
+                double q) {
+  const double aa = a.squaredNorm(), trP = P.trace();
+  return {a * aa + a * trP + 2.0 * P * a + t,
+          aa * aa + 4.0 * a.dot(P * a) + 2.0 * aa * trP + 4.0 * a.dot(t) + q};
+}
+
+CellMoments unionOf(std::span<const CellMoments* const> cells) {
+  CellMoments u;
+  const Eigen::Vector3d origin = cells[0]->mean;
+  Eigen::Vector3d sum_x = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d sum_xx = Eigen::Matrix3d::Zero();
+  Eigen::Vector2d sum_xw = Eigen::Vector2d::Zero();
+  double sum_ww = 0.0;
+  for (const CellMoments* m : cells) {
+    const double n = static_cast<double>(m->count);
+    const Eigen::Vector3d a = m->mean - origin;
+    const Eigen::Matrix3d P = m->covariance * ((n - 1.0) / n);
+    const Raw raw = aboutOffset(a.head<2>(), P.topLeftCorner<2, 2>(), {m->xw, m->yw}, m->ww);
+    u.count += m->count;
+    sum_x += n * a;
+    sum_xx += n * (P + a * a.transpose());
+    sum_xw += n * raw.xw;
+    sum_ww += n * raw.ww;
+  }
+  const double n = static_cast<double>(u.count);
+  const Eigen::Vector3d M = sum_x / n;
+  const Eigen::Matrix3d P = sum_xx / n - M * M.transpose();
+  u.mean = origin + M;
+  u.covariance = P * (n / (n - 1.0));
+  // Central moments about M: E[x w] and E[w^2] about the origin minus the offset's terms.
+  const Eigen::Matrix2d P2 = P.topLeftCorner<2, 2>();
+  const Raw offset = aboutOffset(M.head<2>(), P2, Eigen::Vector2d::Zero(), 0.0);
+  const Eigen::Vector2d t = sum_xw / n - offset.xw;
+  u.xw = t.x();
+  u.yw = t.y();
+  u.ww = sum_ww / n - offset.ww - 4.0 * M.head<2>().dot(t);
+  return u;
+}
+
+/// E[(|x - c|^2 - R^2)^2] / 4 R^2 over the cell's points: their distance variance about a circle.
+double residualVariance(const CellMoments& m, const Eigen::Vector2d& centre, double radius_m) {
+  const double n = static_cast<double>(m.count);
+  const Eigen::Matrix2d P = m.covariance.topLeftCorner<2, 2>() * ((n - 1.0) / n);
+  const Eigen::Vector2d b = m.mean.head<2>() - centre;
+  const double k = b.squaredNorm() - radius_m * radius_m;
+  const double e4 = k * k + 4.0 * b.dot(P * b) + 2.0 * k * P.trace() +
+                    4.0 * b.dot(Eigen::Vector2d(m.xw, m.yw)) + m.ww;
+  return std::max(e4, 0.0) / (4.0 * radius_m * radius_m);
+}
+
+constexpr double kMaxResidualShare = 0.25;  // residual RMS against the radius
+constexpr double kMaxResidual_m = 0.04;
+
+struct StemCircle {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();  ///< m, in the frame of the points
+  double radius_m = 0.0;
+  double residual_variance_m2 = 0.0;
+};
+
+/// The circle of a section's moments when it passes the stem gates (fitStemSection).
+std::optional<StemCircle> stemCircle(const CellMoments& m, double resolution_m) {
+  constexpr std::size_t kMinPoints = 10;
+  constexpr double kMinRadius_m = 0.03;
+  constexpr double kMaxRadiusShare = 0.5;  // of the cell edge
+  constexpr double kMinArcSpread = 0.15;   // largest horizontal variance / R^2: about 80 deg
+  constexpr double kMaxLean = 0.25;        // horizontal drift of the section per m of height
+  if (m.count < kMinPoints) return std::nullopt;
+  const double n = static_cast<double>(m.count);
+  const Eigen::Matrix3d C = m.covariance * ((n - 1.0) / n);
+  const double var_z = C(2, 2);
+  if (!(var_z > 0.0)) return std::nullopt;
+  if (std::hypot(C(0, 2), C(1, 2)) / var_z > kMaxLean) return std::nullopt;
+  Circle circle;
+  if (!taubin(C(0, 0), C(1, 1), C(0, 1), m.xw, m.yw, m.ww, circle)) return std::nullopt;
+  const double r = circle.radius_m;
+  if (!(r >= kMinRadius_m && r <= kMaxRadiusShare * resolution_m)) return std::nullopt;
+  const double residual_rms = std::sqrt(circle.residual_variance_m2);
+  if (residual_rms > kMaxResidualShare * r || residual_rms > kMaxResidual_m) return std::nullopt;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(C.topLeftCorner<2, 2>(),
+                                                                   Eigen::EigenvaluesOnly);
+  if (horizontal.eigenvalues()(1) < kMinArcSpread * r * r) return std::nullopt;
+  return StemCircle{m.mean.head<2>() + circle.centre_from_mean, r, circle.residual_variance_m2};
+}
+
+void makeStemCell(const StemCircle& circle, double min_variance_m2, NdtCell& cell) {
+  // The radial variance is floored as the Gaussian's eigenvalues are; the vertical one is the
+  // cell's.
+  cell.stem = true;
+  cell.stem_centre = circle.centre;
+  cell.stem_radius_m = circle.radius_m;
+  cell.inverse_radial_variance = 1.0 / std::max(circle.residual_variance_m2, min_variance_m2);
+  cell.inverse_vertical_variance = 1.0 / cell.covariance(2, 2);
+}
+
 }  // namespace
 
 bool fitStemSection(const CellMoments& m, double resolution_m, double min_variance_m2,
                     NdtCell& cell) {
-  constexpr std::size_t kMinPoints = 10;
-  constexpr double kMinRadius_m = 0.03;
-  constexpr double kMaxRadiusShare = 0.5;    // of the cell edge
-  constexpr double kMaxResidualShare = 0.25;  // residual RMS against the radius
-  constexpr double kMaxResidual_m = 0.04;
-  constexpr double kMinArcSpread = 0.15;  // largest horizontal variance / R^2: about 80 deg
-  constexpr double kMaxLean = 0.25;       // horizontal drift of the section per m of height
-  if (m.count < kMinPoints) return false;
-  const double n = static_cast<double>(m.count);
-  const Eigen::Matrix3d C = m.covariance * ((n - 1.0) / n);
-  const double var_z = C(2, 2);
-  if (!(var_z > 0.0)) return false;
-  if (std::hypot(C(0, 2), C(1, 2)) / var_z > kMaxLean) return false;
-  Circle circle;
-  if (!taubin(C(0, 0), C(1, 1), C(0, 1), m.xw, m.yw, m.ww, circle)) return false;
-  const double r = circle.radius_m;
-  if (!(r >= kMinRadius_m && r <= kMaxRadiusShare * resolution_m)) return false;
-  const double residual_rms = std::sqrt(circle.residual_variance_m2);
-  if (residual_rms > kMaxResidualShare * r || residual_rms > kMaxResidual_m) return false;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(C.topLeftCorner<2, 2>(),
-                                                                   Eigen::EigenvaluesOnly);
-  if (horizontal.eigenvalues()(1) < kMinArcSpread * r * r) return false;
-  // The radial variance is floored as the Gaussian's eigenvalues are; the vertical one is the
-  // cell's.
-  cell.stem = true;
-  cell.stem_centre = m.mean.head<2>() + circle.centre_from_mean;
-  cell.stem_radius_m = r;
-  cell.inverse_radial_variance = 1.0 / std::max(circle.residual_variance_m2, min_variance_m2);
-  cell.inverse_vertical_variance = 1.0 / cell.covariance(2, 2);
+  const std::optional<StemCircle> circle = stemCircle(m, resolution_m);
+  if (!circle) return false;
+  makeStemCell(*circle, min_variance_m2, cell);
+  return true;
+}
+
+bool fitStemSectionAcross(const CellMoments& own, std::span<const CellMoments* const> block,
+                          double resolution_m, double min_variance_m2, NdtCell& cell) {
+  const std::optional<StemCircle> circle = stemCircle(unionOf(block), resolution_m);
+  if (!circle) return false;
+  const double own_rms = std::sqrt(residualVariance(own, circle->centre, circle->radius_m));
+  if (own_rms > kMaxResidualShare * circle->radius_m || own_rms > kMaxResidual_m) return false;
+  makeStemCell(*circle, min_variance_m2, cell);
   return true;
 }
 

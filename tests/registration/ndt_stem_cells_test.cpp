@@ -110,6 +110,70 @@ TEST(NdtStemCells, WallsBlobsAndShortArcsAreNotStems) {
   EXPECT_FALSE(target.cells()[0].stem);
 }
 
+TEST(NdtStemCells, ABlocksCircleIsTheCircleOfItsPooledPoints) {
+  // A stem at the middle of a 1 m cell, all within one 0.5 m layer: the four 0.5 m cells around
+  // it, pooled by their moments, must give the circle the 1 m cell's own moments give.
+  std::mt19937 rng(8);
+  const Eigen::Vector2d centre(20.5, -7.5);
+  const auto stem = arc(centre, 0.15, {15.0, -9.0}, 2.2, 0.0, 0.004, rng);  // 250 deg
+  VoxelStatistics fine(0.5, true), coarse(1.0, true);
+  fine.add(stem);
+  coarse.add(stem);
+  const std::vector<CellMoments> quarters = fine.moments();
+  const std::vector<CellMoments> whole = coarse.moments();
+  ASSERT_EQ(quarters.size(), 4u);
+  ASSERT_EQ(whole.size(), 1u);
+  const CellMoments* block[] = {&quarters[0], &quarters[1], &quarters[2], &quarters[3]};
+  NdtCell pooled, direct;
+  pooled.covariance = direct.covariance = whole[0].covariance;
+  ASSERT_TRUE(fitStemSection(whole[0], 1.0, 1e-6, direct));
+  for (const CellMoments& own : quarters) {
+    ASSERT_TRUE(fitStemSectionAcross(own, block, 1.0, 1e-6, pooled));
+    EXPECT_NEAR((pooled.stem_centre - direct.stem_centre).norm(), 0.0, 1e-6);
+    EXPECT_NEAR(pooled.stem_radius_m, direct.stem_radius_m, 1e-6);
+    EXPECT_NEAR(pooled.inverse_radial_variance / direct.inverse_radial_variance, 1.0, 1e-3);
+  }
+  EXPECT_NEAR((direct.stem_centre - centre).norm(), 0.0, 0.004);
+  // A cell whose points are off the block's circle (a twig across the block) does not take it.
+  std::vector<Eigen::Vector3d> off;
+  for (int i = 0; i < 40; ++i) off.emplace_back(20.05 + 0.01 * i, -7.95, 0.1 + 0.005 * i);
+  VoxelStatistics elsewhere(0.5, true);
+  elsewhere.add(off);
+  EXPECT_FALSE(fitStemSectionAcross(elsewhere.moments()[0], block, 1.0, 1e-6, pooled));
+}
+
+TEST(NdtStemCells, AStemOnACellCornerBecomesStemCells) {
+  // A 12 cm stem whose axis is the corner of four 0.5 m cells, seen from the -x side as a
+  // 140 deg arc: each of the two cells holds 70 deg, whose own circle fails the gates; the
+  // 2 x 2 block's passes.
+  std::mt19937 rng(9);
+  const Eigen::Vector2d centre(3.0, 1.0);
+  std::vector<Eigen::Vector3d> stem;
+  for (double z0 = 0.0; z0 < 1.5; z0 += 0.5)
+    for (const auto& p : arc(centre, 0.12, {-1.0, 1.0}, 1.2, z0, 0.004, rng)) stem.push_back(p);
+  NdtConfig config;
+  config.resolution_m = 0.5;
+  config.stem_cells = true;
+  const auto stemCells = [&](bool across) {
+    config.stem_cells_across_borders = across;
+    const NdtTarget target = NdtTarget::fromPoints(stem, 0.5, config);
+    int n = 0;
+    for (const NdtCell& cell : target.cells()) {
+      if (!cell.stem) continue;
+      ++n;
+      EXPECT_NEAR((cell.stem_centre - centre).norm(), 0.0, 0.01);
+      EXPECT_NEAR(cell.stem_radius_m, 0.12, 0.01);
+    }
+    return std::pair(n, static_cast<int>(target.cells().size()));
+  };
+  const auto [within, cells] = stemCells(false);
+  const auto [across, same_cells] = stemCells(true);
+  EXPECT_EQ(cells, same_cells);
+  EXPECT_EQ(cells, 6);
+  EXPECT_EQ(within, 0);
+  EXPECT_EQ(across, cells);
+}
+
 /// A scan 4 m ahead of the map's viewpoint, registered from its true pose: the map saw each stem
 /// from (0, 0), the scan from (4, 0); flat ground below. The error along the walk (m).
 double pullAlongWalk_m(bool stem_cells) {

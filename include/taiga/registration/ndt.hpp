@@ -65,6 +65,10 @@ struct NdtConfig {
   /// Score cells holding a stem's section against its circle (see above), at resolution_m
   /// only: the coarser passes are there for their wide basin. Off by default.
   bool stem_cells = false;
+  /// Stem cells also where a stem is cut by cell borders: a cell whose own section fails takes
+  /// the circle of a 2 x 2 block of cells around it (src/registration/ndt_target.cpp). Off by
+  /// default (OdometryConfig::ndt_stem_cells_across_borders).
+  bool stem_cells_across_borders = false;
   int max_iterations = 35;         ///< per resolution
   double step_epsilon_m = 1e-3;    ///< converged when the translation step is below this...
   double step_epsilon_rad = 1e-4;  ///< ...and the rotation step below this
@@ -109,6 +113,10 @@ struct NdtCell {
 /// Gaussian either way.
 bool fitStemSection(const CellMoments& m, double resolution_m, double min_variance_m2,
                     NdtCell& cell);
+/// A stem cut by cell borders: the circle of the section of a block of cells (`own` among them)
+/// under the same gates, when `own`'s points lie on it as closely as the gates ask.
+bool fitStemSectionAcross(const CellMoments& own, std::span<const CellMoments* const> block,
+                          double resolution_m, double min_variance_m2, NdtCell& cell);
 
 /// Target cells with a hash index; built once, read concurrently.
 class NdtTarget {

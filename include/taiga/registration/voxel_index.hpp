@@ -25,6 +25,12 @@ inline VoxelKey packVoxel(std::int64_t ix, std::int64_t iy, std::int64_t iz) {
   return ((ix + kVoxelAxisLimit) << 42) | ((iy + kVoxelAxisLimit) << 21) | (iz + kVoxelAxisLimit);
 }
 
+/// What one step along x, y or z adds to a key (x in bits 42.., y in 21.., z in 0..). Keys from
+/// voxelOf are away from the axis limits (|i| < 1e6 < 2^20 - 1), so a step stays in its axis.
+inline constexpr VoxelKey kVoxelStepX = VoxelKey{1} << 42;
+inline constexpr VoxelKey kVoxelStepY = VoxelKey{1} << 21;
+inline constexpr VoxelKey kVoxelStepZ = 1;
+
 inline Eigen::Matrix<std::int64_t, 3, 1> unpackVoxel(VoxelKey key) {
   const std::int64_t mask = (std::int64_t{1} << 21) - 1;
   return {((key >> 42) & mask) - kVoxelAxisLimit, ((key >> 21) & mask) - kVoxelAxisLimit,
