@@ -104,9 +104,17 @@ void OdometryConfig::visit(ConfigVisitor& v) {
            "neighbours (direct7)");
   v.field("ndt_stem_cells", ndt_stem_cells,
           "true: NDT cells holding a stem's section score points by their distance to its "
-          "circle, the same from every side (half the shrink, but not yet robust in a lidar-only "
-          "re-attachment; docs/registration.md, Bias)");
+          "circle, the same from every side (half the shrink; docs/registration.md, Bias)");
+  v.field("ndt_stem_cells_across_borders", ndt_stem_cells_across_borders,
+          "true: a cell whose own part of a stem is too short for a circle takes the circle of a "
+          "2 x 2 block of cells around it (a stem cut by cell borders; slightly less shrink, but "
+          "IMU-gap bridging diverged with it; docs/registration.md, Bias)");
   v.field("local_map_voxel_m", local_map_voxel_m, "m, spacing of keyframe points in the local map");
+  static constexpr std::array<std::string_view, 2> kLocalMapPoints{"centroid", "bearing"};
+  v.choice("local_map_point", local_map_point, kLocalMapPoints,
+           "the point that stands for each local-map voxel of a keyframe: centroid, or bearing "
+           "(the return whose direction from the lidar is nearest the centroid's: on a stem's "
+           "surface, not inside it; docs/registration.md, Bias)");
   v.field("local_map_keyframes", local_map_keyframes, "keyframes held in the local map");
   v.field("lidar_sigma", lidar_sigma,
           "m and rad, sigma of the lidar factor at good fitness (thesis sigma_sm)");

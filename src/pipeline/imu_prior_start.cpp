@@ -59,8 +59,7 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
                                                    readings, init.bias, gravity_odom_);
     const PointCloud second_in_body =
         preparation_.deskewedInBody(second, imu::toTrajectory(over_second));
-    std::vector<Eigen::Vector3d> target_in_odom =
-        preprocess::voxelFilter(first_in_body, config_.local_map_voxel_m).positions;
+    std::vector<Eigen::Vector3d> target_in_odom = preparation_.localMapPoints(first_in_body);
     const lie::SE3 T_odom_first = poseOf(at_first_end);
     for (Eigen::Vector3d& p : target_in_odom) p = T_odom_first * p;
     const registration::RegistrationResult r = registration::alignNdt(

@@ -295,9 +295,8 @@ void Odometry::maybeAddKeyframe(ScanOutcome& outcome, PointCloud&& cloud_in_body
   if (fromLastKeyframe_m(outcome.T_odom_body) < config_.keyframe_distance_m) return;
   outcome.keyframe_id = keyframes_made_++;
   last_keyframe_T_odom_body_ = outcome.T_odom_body;
-  local_map_.addKeyframe(
-      *outcome.keyframe_id, outcome.T_odom_body,
-      preprocess::voxelFilter(cloud_in_body, config_.local_map_voxel_m).positions);
+  local_map_.addKeyframe(*outcome.keyframe_id, outcome.T_odom_body,
+                         preparation_->localMapPoints(cloud_in_body));
   outcome.keyframe_cloud_in_body = std::move(cloud_in_body);
 }
 

@@ -8,6 +8,8 @@ namespace taiga::pipeline {
 ScanPreparation::ScanPreparation(const OdometryConfig& config, const RigConfig& rig)
     : min_range_m_(config.min_range_m),
       max_range_m_(config.max_range_m),
+      local_map_voxel_m_(config.local_map_voxel_m),
+      local_map_point_(preprocess::voxelRepresentative(config.local_map_point)),
       T_body_lidar_(rig.T_body_lidar) {
   const lie::SE3 T_lidar_body = T_body_lidar_.inverse();
   for (const Box& box : rig.self_boxes_body)
@@ -30,6 +32,16 @@ PointCloud ScanPreparation::deskewedInBody(const io::Scan& scan,
   return preprocess::deskew(forestPointsInLidar(scan), T_body_lidar_, sweep_T_odom_body,
                             scan.t_end_s)
       .cloud_in_body;
+}
+
+std::vector<Eigen::Vector3d> ScanPreparation::localMapPoints(
+    const PointCloud& cloud_in_body) const {
+  // The lidar's position at the scan's end stands for its positions over the sweep: a bearing
+  // moves by at most the sweep's travel over the range, which picks a neighbour of the same
+  // surface, not a point off it.
+  return preprocess::voxelFilter(cloud_in_body, local_map_voxel_m_, local_map_point_,
+                                 T_body_lidar_.translation())
+      .positions;
 }
 
 }  // namespace taiga::pipeline

@@ -12,6 +12,7 @@
 #include "taiga/core/rig_config.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/io/recording.hpp"
+#include "taiga/preprocess/voxel_filter.hpp"
 
 namespace taiga::pipeline {
 
@@ -26,11 +27,17 @@ class ScanPreparation {
   /// in the body frame at scan.t_end_s.
   PointCloud deskewedInBody(const io::Scan& scan, const Trajectory& sweep_T_odom_body) const;
 
+  /// A deskewed scan's points for the local map: one per voxel of odometry.local_map_voxel_m,
+  /// the odometry.local_map_point of it.
+  std::vector<Eigen::Vector3d> localMapPoints(const PointCloud& cloud_in_body) const;
+
  private:
   /// The scan's returns within the range limits and outside the rig's boxes, in the lidar frame.
   PointCloud forestPointsInLidar(const io::Scan& scan) const;
 
   double min_range_m_, max_range_m_;
+  double local_map_voxel_m_;
+  preprocess::VoxelRepresentative local_map_point_;
   lie::SE3 T_body_lidar_;
   std::vector<OrientedBox> self_boxes_lidar_;  ///< rig.self_boxes_body in the lidar frame
   MovingBoxes moving_boxes_body_;

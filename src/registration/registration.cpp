@@ -33,6 +33,7 @@ RegistrationConfig registrationConfigFor(const OdometryConfig& odometry) {
   config.ndt.search =
       odometry.ndt_neighbours == "direct1" ? NeighbourSearch::kDirect1 : NeighbourSearch::kDirect7;
   config.ndt.stem_cells = odometry.ndt_stem_cells;
+  config.ndt.stem_cells_across_borders = odometry.ndt_stem_cells_across_borders;
   return config;
 }
 

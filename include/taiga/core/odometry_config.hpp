@@ -92,7 +92,15 @@ struct OdometryConfig final : ConfigSection {
   /// NDT cells holding a stem's section score points by their distance to its circle
   /// (registration/ndt.hpp, "Stem cells"; docs/registration.md, "Bias"): half the shrink.
   bool ndt_stem_cells = true;
+  /// ...also where a stem is cut by cell borders (NdtConfig::stem_cells_across_borders). Off: it
+  /// took at most 0.003 % more off the shrink, and IMU-gap bridging diverged with it
+  /// (docs/registration.md, "Local-map points on the surface, and stems across cell borders").
+  bool ndt_stem_cells_across_borders = false;
   double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
+  /// Which point stands for each local-map voxel of a keyframe: centroid, or bearing (the return
+  /// whose direction from the lidar is nearest the centroid's: on the surface, with its range
+  /// noise not selected for; docs/registration.md, "Local-map points on the surface").
+  std::string local_map_point = "bearing";
   int local_map_keyframes = 20;            ///< keyframes the local map holds
   // Lidar factor covariance from the fitness score (thesis Eq. 36, see docs/odometry.md).
   double lidar_sigma =
