@@ -20,9 +20,10 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <span>
-#include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,7 @@ struct Options {
   double source_noise_m = 0.0, map_noise_m = 0.0;  ///< added 1-sigma range noise (diagnosis)
   bool reverse = false;  ///< also register the map (as source) to the scan (as target)
   bool stem_cells = false;  ///< NdtConfig::stem_cells
+  bool stem_cells_across_borders = false;  ///< NdtConfig::stem_cells_across_borders
 };
 
 struct TrueScan {
@@ -77,18 +79,22 @@ struct TrueScan {
 };
 
 std::vector<Eigen::Vector3d> representatives(const PointCloud& cloud, double voxel_m,
-                                             const std::string& mode) {
+                                             const std::string& mode,
+                                             const Eigen::Vector3d& sensor) {
   if (mode == "raw") return cloud.positions;
-  return preprocess::voxelFilter(cloud, voxel_m, preprocess::voxelRepresentative(mode)).positions;
+  return preprocess::voxelFilter(cloud, voxel_m, preprocess::voxelRepresentative(mode), sensor)
+      .positions;
 }
 
 std::vector<Eigen::Vector3d> voxelCentroids(const PointCloud& cloud_in_body, double voxel_m,
                                             const lie::SE3& T_world_body, bool world_grid,
-                                            const std::string& mode) {
-  if (!world_grid) return representatives(cloud_in_body, voxel_m, mode);
+                                            const std::string& mode,
+                                            const Eigen::Vector3d& lidar_in_body) {
+  if (!world_grid) return representatives(cloud_in_body, voxel_m, mode, lidar_in_body);
   PointCloud in_world;
   for (const Eigen::Vector3d& p : cloud_in_body.positions) in_world.positions.push_back(T_world_body * p);
-  std::vector<Eigen::Vector3d> centroids = representatives(in_world, voxel_m, mode);
+  std::vector<Eigen::Vector3d> centroids =
+      representatives(in_world, voxel_m, mode, T_world_body * lidar_in_body);
   const lie::SE3 T_body_world = T_world_body.inverse();
   for (Eigen::Vector3d& p : centroids) p = T_body_world * p;
   return centroids;
@@ -115,9 +121,9 @@ std::vector<TrueScan> readTrueScans(const Options& o, const SystemConfig& config
     const lie::SE3 T_world_body = truth.poseAt(scan->t_end_s);
     scans.push_back({T_world_body,
                      voxelCentroids(inBody(o.source_noise_m), 0.4, T_world_body, o.world_voxels,
-                                    o.source_sample),
+                                    o.source_sample, config.rig.T_body_lidar.translation()),
                      voxelCentroids(inBody(o.map_noise_m), 0.2, T_world_body, o.world_voxels,
-                                    o.map_sample)});
+                                    o.map_sample, config.rig.T_body_lidar.translation())});
   }
   return scans;
 }
@@ -150,6 +156,7 @@ registration::RegistrationResult align(const Options& o, std::span<const Eigen::
   registration::NdtConfig ndt;
   ndt.resolution_m = o.resolution_m;
   ndt.stem_cells = o.stem_cells;
+  ndt.stem_cells_across_borders = o.stem_cells_across_borders;
   if (o.method == "gicp") return registration::alignGicp(source, map_in_world, guess, {});
   lie::SE3 start = guess;
   if (o.coarse_resolution_m > 0.0) {
@@ -243,25 +250,70 @@ void measureBias(const Options& o, const std::vector<TrueScan>& scans) {
                 1e3 * mean(reverse_along_m));
 }
 
+/// The simulator's stems (trees.csv: id,x,y,z,dbh,height,lean_deg,lean_azimuth_deg,species,
+/// x_bh,y_bh): the axis at breast height, its lean and the radius there.
+struct TrueStem {
+  Eigen::Vector3d at_breast_height;
+  Eigen::Vector2d lean_per_m;  ///< horizontal drift of the axis per m of height
+  double radius_m;
+};
+
+std::vector<TrueStem> readTrueStems(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error("cannot read " + path);
+  std::vector<TrueStem> stems;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::size_t start = 0;
+    for (std::size_t c = line.find(',');; c = line.find(',', start)) {
+      f.push_back(line.substr(start, c - start));
+      if (c == std::string::npos) break;
+      start = c + 1;
+    }
+    if (f.size() < 11) continue;
+    const double lean = std::tan(std::stod(f[6]) * kRadPerDeg);
+    const double azimuth = std::stod(f[7]) * kRadPerDeg;
+    stems.push_back({Eigen::Vector3d(std::stod(f[9]), std::stod(f[10]), std::stod(f[3]) + 1.3),
+                     lean * Eigen::Vector2d(std::cos(azimuth), std::sin(azimuth)),
+                     0.5 * std::stod(f[4])});
+  }
+  return stems;
+}
+
+/// Horizontal distance from q to the nearest true stem's surface (negative inside), m.
+double distanceToStem(const std::vector<TrueStem>& stems, const Eigen::Vector3d& q) {
+  double best = 1e9;
+  for (const TrueStem& s : stems) {
+    const Eigen::Vector2d axis =
+        s.at_breast_height.head<2>() + s.lean_per_m * (q.z() - s.at_breast_height.z());
+    best = std::min(best, (q.head<2>() - axis).norm() - s.radius_m);
+  }
+  return best;
+}
+
 /// Where the bias comes from: each scan's NDT gradient at its true pose, split by the kind of
 /// surface each source point is scored against (its cell's normal: ground-like, upright or
 /// other) and by range, mapped through the whole scan's Hessian to the pose error each class
 /// alone would cause (delta = -H^-1 g, body frame, then along travel). The classes add up to the
 /// one-Newton-step error from the truth.
 void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
+  const std::vector<TrueStem> stems = readTrueStems(o.sim_dir + "/trees.csv");
   std::vector<std::size_t> keyframes{0};
   for (std::size_t i = 1; i < scans.size(); ++i) {
     const Eigen::Vector3d last = scans[keyframes.back()].T_world_body.translation();
     if ((scans[i].T_world_body.translation() - last).norm() >= 1.0) keyframes.push_back(i);
   }
-  const char* kClasses[] = {"ground (|n_z| > 0.8)", "upright (|n_z| < 0.3)", "other",
-                            "range < 5 m", "range 5-10 m", "range 10-20 m", "range > 20 m",
-                            "in stem cells"};
-  constexpr int kNumClasses = 8;
+  const char* kClasses[] = {
+      "ground (|n_z| > 0.8)", "upright (|n_z| < 0.3)",  "other",        "range < 5 m",
+      "range 5-10 m",         "range 10-20 m",          "range > 20 m", "in stem cells",
+      "upright, other, stem", "upright, other, no stem"};
+  constexpr int kNumClasses = 10;
   std::vector<double> along_m[kNumClasses], up_m[kNumClasses], total_along_m, total_up_m;
   registration::NdtConfig ndt;
   ndt.resolution_m = o.resolution_m;
   ndt.stem_cells = o.stem_cells;
+  ndt.stem_cells_across_borders = o.stem_cells_across_borders;
   std::size_t num_points = 0, num_upright = 0, num_stem = 0;
   for (std::size_t i = 1; i + 1 < scans.size(); i += o.every) {
     std::vector<std::size_t> chosen;
@@ -288,6 +340,9 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
       const double r = p.norm();
       by_class[r < 5 ? 3 : r < 10 ? 4 : r < 20 ? 5 : 6].push_back(p);
       if (cells[0]->stem) by_class[7].push_back(p);
+      if (n_z < 0.3 && !cells[0]->stem) {
+        by_class[distanceToStem(stems, q) < 0.1 ? 8 : 9].push_back(p);
+      }
       ++num_points;
       if (n_z < 0.3) ++num_upright;
       if (cells[0]->stem) ++num_stem;
@@ -420,11 +475,15 @@ int main(int argc, char** argv) {
   app.add_option("--range-scale", o.range_scale, "multiply every range (diagnosis)");
   app.add_option("--range-offset", o.range_offset_m, "add to every range, m (diagnosis)");
   app.add_flag("--world-voxels", o.world_voxels, "voxel grids fixed in the world (diagnosis)");
-  app.add_option("--source-sample", o.source_sample, "centroid | measured | raw (0.4 m voxels)");
-  app.add_option("--map-sample", o.map_sample, "centroid | measured | raw (0.2 m voxels)");
+  app.add_option("--source-sample", o.source_sample,
+                 "centroid | measured | bearing | raw (0.4 m voxels)");
+  app.add_option("--map-sample", o.map_sample,
+                 "centroid | measured | bearing | raw (0.2 m voxels)");
   app.add_option("--source-noise", o.source_noise_m, "add range noise to the source, 1-sigma m");
   app.add_option("--map-noise", o.map_noise_m, "add range noise to the map points, 1-sigma m");
   app.add_flag("--stem-cells", o.stem_cells, "NDT stem cells (ndt.hpp)");
+  app.add_flag("--stem-cells-across-borders", o.stem_cells_across_borders,
+               "stem cells also from 2 x 2 blocks of cells (a stem cut by cell borders)");
   app.add_flag("--reverse", o.reverse, "also register the map to the scan (bias)");
   CLI11_PARSE(app, argc, argv);
   if (o.every < 1 || o.num_keyframes < 1 || o.skip_keyframes < 0) {
