@@ -23,7 +23,6 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <span>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -40,6 +39,7 @@
 #include "taiga/registration/ndt.hpp"
 #include "taiga/sim/scenario_yaml.hpp"
 #include "taiga/sim/simulator.hpp"
+#include "taiga/trees/tree_files.hpp"
 
 using namespace taiga;
 
@@ -250,8 +250,7 @@ void measureBias(const Options& o, const std::vector<TrueScan>& scans) {
                 1e3 * mean(reverse_along_m));
 }
 
-/// The simulator's stems (trees.csv: id,x,y,z,dbh,height,lean_deg,lean_azimuth_deg,species,
-/// x_bh,y_bh): the axis at breast height, its lean and the radius there.
+/// The simulator's stems (trees.csv): the axis at breast height, its lean and the radius there.
 struct TrueStem {
   Eigen::Vector3d at_breast_height;
   Eigen::Vector2d lean_per_m;  ///< horizontal drift of the axis per m of height
@@ -259,24 +258,13 @@ struct TrueStem {
 };
 
 std::vector<TrueStem> readTrueStems(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error("cannot read " + path);
+  constexpr double kBreastHeight_m = 1.3;  // x_bh_m, y_bh_m are the axis there
   std::vector<TrueStem> stems;
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::size_t start = 0;
-    for (std::size_t c = line.find(',');; c = line.find(',', start)) {
-      f.push_back(line.substr(start, c - start));
-      if (c == std::string::npos) break;
-      start = c + 1;
-    }
-    if (f.size() < 11) continue;
-    const double lean = std::tan(std::stod(f[6]) * kRadPerDeg);
-    const double azimuth = std::stod(f[7]) * kRadPerDeg;
-    stems.push_back({Eigen::Vector3d(std::stod(f[9]), std::stod(f[10]), std::stod(f[3]) + 1.3),
-                     lean * Eigen::Vector2d(std::cos(azimuth), std::sin(azimuth)),
-                     0.5 * std::stod(f[4])});
+  for (const trees::TreeRecord& t : trees::readTreesCsv(path)) {
+    const double lean = std::tan(t.lean_deg * kRadPerDeg);
+    const double azimuth = t.lean_azimuth_deg * kRadPerDeg;
+    stems.push_back({Eigen::Vector3d(t.bh_xy_m.x(), t.bh_xy_m.y(), t.ground_z_m + kBreastHeight_m),
+                     lean * Eigen::Vector2d(std::cos(azimuth), std::sin(azimuth)), 0.5 * t.dbh_m});
   }
   return stems;
 }

@@ -126,6 +126,7 @@ std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string
   const std::size_t c_x = has_bh ? *find("x_bh_m") : require("x_m");
   const std::size_t c_y = has_bh ? *find("y_bh_m") : require("y_m");
   const auto c_z = find("z_m"), c_height = find("height_m"), c_sigma = find("dbh_sigma_m");
+  const auto c_lean = find("lean_deg"), c_lean_azimuth = find("lean_azimuth_deg");
 
   std::vector<TreeRecord> trees;
   for (int number = 2; std::getline(in, line); ++number) {
@@ -155,6 +156,8 @@ std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string
     t.dbh_m = number_in(c_dbh);
     t.dbh_sigma_m = c_sigma ? number_in(*c_sigma) : kNaN;
     t.height_m = c_height ? number_in(*c_height) : kNaN;
+    t.lean_deg = c_lean ? number_in(*c_lean) : kNaN;
+    t.lean_azimuth_deg = c_lean_azimuth ? number_in(*c_lean_azimuth) : kNaN;
     trees.push_back(t);
   }
   return trees;

@@ -28,11 +28,14 @@ TEST(TreeFiles, ReadsTheSimulatorsAndTaigasListsByColumnName) {
   EXPECT_EQ(sim[0].id, 7);
   EXPECT_EQ(sim[0].bh_xy_m, Eigen::Vector2d(3.17, 24.14));  // breast height, not the base
   EXPECT_DOUBLE_EQ(sim[0].dbh_m, 0.265);
+  EXPECT_DOUBLE_EQ(sim[0].lean_deg, 1.8);
+  EXPECT_DOUBLE_EQ(sim[0].lean_azimuth_deg, 313.6);
   // Without breast-height columns the x_m, y_m columns are taken; without heights NaN.
   const auto plain = parseTreesCsv("dbh_m,y_m,x_m,id\r\n0.3,2,1,4\r\n\n", "plain");
   ASSERT_EQ(plain.size(), 1u);
   EXPECT_EQ(plain[0].bh_xy_m, Eigen::Vector2d(1, 2));
   EXPECT_TRUE(std::isnan(plain[0].height_m));
+  EXPECT_TRUE(std::isnan(plain[0].lean_deg));
 }
 
 TEST(TreeFiles, BadInputNamesTheLineAndColumn) {

@@ -42,11 +42,13 @@ struct TreeRecord {
   double dbh_m = 0.0;
   double height_m = 0.0;
   double dbh_sigma_m = 0.0;
+  double lean_deg = 0.0;          ///< the axis' angle from vertical
+  double lean_azimuth_deg = 0.0;  ///< the direction it leans toward, from +x toward +y
 };
 
 /// Reads a trees.csv by its header's column names (id, x_m, y_m, dbh_m required; x_bh_m, y_bh_m,
-/// z_m, dbh_sigma_m, height_m used when present). InputError naming the file, line and column
-/// otherwise.
+/// z_m, dbh_sigma_m, height_m, lean_deg, lean_azimuth_deg used when present). InputError naming the
+/// file, line and column otherwise.
 std::vector<TreeRecord> readTreesCsv(const std::filesystem::path& path);
 /// The same from a file's text (tests, fuzzing); `source` names it in messages.
 std::vector<TreeRecord> parseTreesCsv(const std::string& text, const std::string& source);
