@@ -16,7 +16,6 @@ namespace {
 struct Circle {
   Eigen::Vector2d centre_from_mean = Eigen::Vector2d::Zero();  ///< m
   double radius_m = 0.0;
-  double residual_variance_m2 = 0.0;  ///< of a point's distance to the circle
 };
 
 // Central moments (1/n) of the section: xx, yy, xy in m^2, xw, yw in m^3, ww in m^4, w = x^2+y^2.
@@ -46,13 +45,7 @@ bool taubin(double xx, double yy, double xy, double xw, double yw, double ww, Ci
                           (yw * (xx - eta) - xw * xy) / (2.0 * det));
   out.centre_from_mean = c;
   out.radius_m = std::sqrt(c.squaredNorm() + mz);
-  // E[(d^2 - R^2)^2] about the fitted circle, from the moments (k = |c|^2 - R^2 = -mz), and
-  // d - R ~ (d^2 - R^2) / 2R near the circle.
-  const double k = -mz;
-  const double e4 = ww + 4.0 * (c.x() * c.x() * xx + c.y() * c.y() * yy + 2.0 * c.x() * c.y() * xy) -
-                    4.0 * (c.x() * xw + c.y() * yw) + k * k + 2.0 * k * mz;
-  out.residual_variance_m2 = std::max(e4, 0.0) / (4.0 * out.radius_m * out.radius_m);
-  return std::isfinite(out.radius_m) && std::isfinite(out.residual_variance_m2);
+  return std::isfinite(out.radius_m);
 }
 
 // The central moments (1/n) of the union of cells, from each cell's count, mean, covariance
@@ -106,7 +99,8 @@ CellMoments unionOf(std::span<const CellMoments* const> cells) {
   return u;
 }
 
-/// E[(|x - c|^2 - R^2)^2] / 4 R^2 over the cell's points: their distance variance about a circle.
+/// E[(|x - c|^2 - R^2)^2] / 4 R^2 over the cell's points, from its moments: the variance of their
+/// distance to the circle (d - R ~ (d^2 - R^2) / 2R near it).
 double residualVariance(const CellMoments& m, const Eigen::Vector2d& centre, double radius_m) {
   const double n = static_cast<double>(m.count);
   const Eigen::Matrix2d P = m.covariance.topLeftCorner<2, 2>() * ((n - 1.0) / n);
@@ -117,8 +111,12 @@ double residualVariance(const CellMoments& m, const Eigen::Vector2d& centre, dou
   return std::max(e4, 0.0) / (4.0 * radius_m * radius_m);
 }
 
-constexpr double kMaxResidualShare = 0.25;  // residual RMS against the radius
-constexpr double kMaxResidual_m = 0.04;
+/// The residual gate: points whose distance variance about a circle of radius r is this small
+/// lie on it (RMS under a quarter of the radius and 4 cm; false for NaN).
+bool liesOnCircle(double residual_variance_m2, double radius_m) {
+  const double rms = std::sqrt(residual_variance_m2);
+  return rms <= 0.25 * radius_m && rms <= 0.04;
+}
 
 struct StemCircle {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();  ///< m, in the frame of the points
@@ -143,12 +141,13 @@ std::optional<StemCircle> stemCircle(const CellMoments& m, double resolution_m) 
   if (!taubin(C(0, 0), C(1, 1), C(0, 1), m.xw, m.yw, m.ww, circle)) return std::nullopt;
   const double r = circle.radius_m;
   if (!(r >= kMinRadius_m && r <= kMaxRadiusShare * resolution_m)) return std::nullopt;
-  const double residual_rms = std::sqrt(circle.residual_variance_m2);
-  if (residual_rms > kMaxResidualShare * r || residual_rms > kMaxResidual_m) return std::nullopt;
+  const Eigen::Vector2d centre = m.mean.head<2>() + circle.centre_from_mean;
+  const double residual_variance_m2 = residualVariance(m, centre, r);
+  if (!liesOnCircle(residual_variance_m2, r)) return std::nullopt;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(C.topLeftCorner<2, 2>(),
                                                                    Eigen::EigenvaluesOnly);
   if (horizontal.eigenvalues()(1) < kMinArcSpread * r * r) return std::nullopt;
-  return StemCircle{m.mean.head<2>() + circle.centre_from_mean, r, circle.residual_variance_m2};
+  return StemCircle{centre, r, residual_variance_m2};
 }
 
 void makeStemCell(const StemCircle& circle, double min_variance_m2, NdtCell& cell) {
@@ -175,8 +174,9 @@ bool fitStemSectionAcross(const CellMoments& own, std::span<const CellMoments* c
                           double resolution_m, double min_variance_m2, NdtCell& cell) {
   const std::optional<StemCircle> circle = stemCircle(unionOf(block), resolution_m);
   if (!circle) return false;
-  const double own_rms = std::sqrt(residualVariance(own, circle->centre, circle->radius_m));
-  if (own_rms > kMaxResidualShare * circle->radius_m || own_rms > kMaxResidual_m) return false;
+  if (!liesOnCircle(residualVariance(own, circle->centre, circle->radius_m), circle->radius_m)) {
+    return false;
+  }
   makeStemCell(*circle, min_variance_m2, cell);
   return true;
 }
