@@ -30,8 +30,8 @@ PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m,
                        VoxelRepresentative representative = VoxelRepresentative::centroid,
                        const Eigen::Vector3d& sensor = Eigen::Vector3d::Zero());
 
-/// "centroid", "measured" or "bearing" (OdometryConfig::voxel_point); throws std::invalid_argument
-/// else.
+/// "centroid", "measured" or "bearing" (OdometryConfig::voxel_point, local_map_point); throws
+/// std::invalid_argument else.
 VoxelRepresentative voxelRepresentative(std::string_view name);
 
 }  // namespace taiga::preprocess
