@@ -67,6 +67,19 @@ void useOneMallocArena() {
 
 // The health monitor's verdict; the first lost stretch with its reason, since that is where a
 // user looks first.
+void printLostTrack(const pipeline::HealthReport& h) {
+  const std::vector<std::uint64_t> floating = h.floatingSegments();
+  for (const std::uint64_t segment : floating)
+    fmt::print(
+        "           map segment {0} never found in the map: it stays where dead reckoning put it, "
+        "not tied to the map, and its keyframes are in map_segment_{0}.las, not map.las\n",
+        segment);
+  if (!floating.empty() && !h.ended_lost && floating.back() + 1 < h.map_segments)
+    fmt::print("           the later segments are tied to the map again\n");
+  if (h.ended_lost) fmt::print("           the run ended lost: its last scans are not trusted\n");
+  fmt::print("           scans.csv marks every scan (exit code 3)\n");
+}
+
 void printHealth(const pipeline::HealthReport& h) {
   fmt::print("health     {}: {} scans ok, {} degraded, {} lost; {} map segment{}\n", h.verdict(),
              h.ok, h.degraded, h.lost, h.map_segments, h.map_segments == 1 ? "" : "s");
@@ -97,11 +110,7 @@ void printHealth(const pipeline::HealthReport& h) {
         "           map segment {} re-attached to the map at {:.1f} s: {:.2f} m / {:.2f} deg from "
         "dead reckoning, {:.0f} % of its points above the ground on the map\n",
         r.segment, r.t_s, r.correction_m, r.correction_deg, 100.0 * r.overlap);
-  if (h.trackLost())
-    fmt::print(
-        "           the track was lost and not re-attached: the trajectory and map after it are "
-        "not tied to those before it (scans.csv marks every scan, map_segment_N.las holds what "
-        "is not in map.las; exit code 3)\n");
+  if (h.trackLost()) printLostTrack(h);
 }
 
 void printCalibration(const pipeline::CalibrationRunReport& c) {

@@ -9,7 +9,8 @@ bool measuredByLidar(const ScanOutcome& o) {
 std::optional<calib::RotationIncrement> RotationIncrements::take(const ScanOutcome& o) {
   const lie::SO3& R_odom_body = o.registration.T_target_source.rotation();
   const bool follows = previous_ && previous_->measured && measuredByLidar(o) &&
-                       o.scan_index == previous_->scan_index + 1 && !o.T_odom_unlevelled;
+                       o.scan_index == previous_->scan_index + 1 && !o.T_odom_unlevelled &&
+                       o.imu_gap_s <= max_imu_gap_s_;
   std::optional<calib::RotationIncrement> increment;
   if (follows)
     increment = calib::RotationIncrement{previous_->t_s, o.t_s,

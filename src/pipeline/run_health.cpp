@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "taiga/core/log.hpp"
 #include "taiga/core/percentile.hpp"
 
@@ -12,6 +14,16 @@ std::string HealthReport::verdict() const {
   if (calibration_suspect) return "suspect";
   if (lost > 0) return "recovered";
   return degraded > 0 ? "degraded" : "ok";
+}
+
+std::vector<std::uint64_t> HealthReport::floatingSegments() const {
+  std::vector<std::uint64_t> floating;
+  for (std::uint64_t segment = 1; segment < map_segments; ++segment) {
+    const bool found = std::any_of(reattached.begin(), reattached.end(),
+                                   [&](const Reattachment& r) { return r.segment == segment; });
+    if (!found) floating.push_back(segment);
+  }
+  return floating;
 }
 
 void HealthLog::onScan(const ScanOutcome& scan, const lie::SE3& /*T_map_odom*/) {

@@ -35,7 +35,7 @@ PassData runPass(const std::filesystem::path& path, const SystemConfig& config,
   const Eigen::Matrix3d R_body_imu = rig.T_body_imu.rotation().matrix();
   PassData data;
   std::optional<double> first_scan_s;
-  RotationIncrements increments;
+  RotationIncrements increments(config.odometry.health.max_imu_gap_s);
   std::vector<std::vector<StampedPose>>& chains = data.lever_arm.chains;
   auto take = [&](const ScanOutcome& o) {
     const std::optional<calib::RotationIncrement> increment = increments.take(o);

@@ -16,9 +16,15 @@ bool measuredByLidar(const ScanOutcome& o);
 
 class RotationIncrements {
  public:
+  /// `max_imu_gap_s` (odometry.health.max_imu_gap_s): an increment over which the IMU was silent
+  /// for longer has no gyro readings to compare with (the estimators interpolate the rate across
+  /// the gap), and is not taken.
+  explicit RotationIncrements(double max_imu_gap_s = HealthConfig{}.max_imu_gap_s)
+      : max_imu_gap_s_(max_imu_gap_s) {}
   /// The rotation from the previous outcome to `o` (Log(R_prev^T R_o), body frame, at the
-  /// outcomes' times) when both were measured, they are consecutive scans, and `o` is not the
-  /// scan at which the odom frame was levelled (its pose changes frame there).
+  /// outcomes' times) when both were measured, they are consecutive scans, the IMU read through
+  /// the interval, and `o` is not the scan at which the odom frame was levelled (its pose changes
+  /// frame there).
   std::optional<calib::RotationIncrement> take(const ScanOutcome& o);
 
  private:
@@ -28,6 +34,7 @@ class RotationIncrements {
     bool measured = false;
     lie::SO3 R_odom_body;
   };
+  double max_imu_gap_s_;
   std::optional<Previous> previous_;
 };
 

@@ -112,7 +112,9 @@ struct HealthReport {
   std::vector<Reattachment> reattached;  ///< segments after the first that were found again
   /// Lost and not re-attached to the same map: the run ended lost, or started a segment that
   /// was not re-attached.
-  bool trackLost() const { return ended_lost || map_segments > 1 + reattached.size(); }
+  bool trackLost() const { return ended_lost || !floatingSegments().empty(); }
+  /// The segments after the first that were never found in the map, in order.
+  std::vector<std::uint64_t> floatingSegments() const;
   /// "ok", "degraded", "recovered" (lost, then re-attached to the same map), "suspect" (the
   /// calibration, see calibration_suspect) or "lost".
   std::string verdict() const;
