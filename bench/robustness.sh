@@ -9,7 +9,8 @@
 #       scenario's own), BEAMS=64 to simulate fewer lidar rows (default: the full 128),
 #       KEEP=1 to keep the recordings, OVERRIDES=file.yaml passed to every `taiga simulate`
 #       (a recording kind, docs/simulator.md) with TAG=name, which the csv's scenario column
-#       then carries as scenario[name])
+#       then carries as scenario[name]), RIG=rig_truth.yaml to run with the simulator's true rig
+#       instead (default rig.yaml))
 #
 # One row per run is appended to WORK_DIR/robustness.csv as soon as it is done; cells already in
 # it are skipped, so an interrupted table resumes. bench/robustness.py turns it into Markdown and
@@ -52,7 +53,7 @@ for scenario in ${SCENARIOS:-handheld-loop harvester dense_spruce}; do
       "$taiga" simulate --scenario "$scenario" --realism "$realism" --seed "$seed" \
         "${duration_args[@]}" "${beam_args[@]}" --out "$sim" > "$sim.log" 2>&1
       code=0
-      "$taiga" run "$sim/recording.bag" --config "$sim/rig.yaml" --out "$run" \
+      "$taiga" run "$sim/recording.bag" --config "$sim/${RIG:-rig.yaml}" --out "$run" \
         > "$run.log" 2>&1 || code=$?
       read -r ate ate_max drift drift_pct path < <(evaluate "$run/trajectory.tum" "$sim/groundtruth.tum")
       read -r ate_odom _ < <(evaluate "$run/trajectory_odometry.tum" "$sim/groundtruth.tum")

@@ -100,14 +100,15 @@ OdometrySmoother::OdometrySmoother(OdometrySmootherOptions options) : options_(o
 
 OdometrySmoother::~OdometrySmoother() = default;
 
-void OdometrySmoother::initialize(const StateEstimate& first, double tilt_sigma_rad) {
+void OdometrySmoother::initialize(const StateEstimate& first, double tilt_sigma_rad,
+                                  const Eigen::Vector2d& tilt) {
   window_.clear();
   auto node = std::make_unique<Node>();
   node->t_s = first.t_s;
   node->blocks = StateBlocks::from(first.state, first.bias);
-  tilt_ = {0.0, 0.0};
+  tilt_ = {tilt.x(), tilt.y()};
   tilt_sigma_rad_ = tilt_sigma_rad;
-  node->prior = std::make_unique<StatePrior>(node->blocks, StatePrior::Tilt::Zero(),
+  node->prior = std::make_unique<StatePrior>(node->blocks, StatePrior::Tilt(tilt),
                                              withTilt(first.covariance, tilt_sigma_rad_));
   window_.push_back(std::move(node));
   latest_ = first;
@@ -131,6 +132,8 @@ StateEstimate OdometrySmoother::addState(double t_s, const imu::Preintegrator& p
   optimize();
   return latest_;
 }
+
+void OdometrySmoother::reset() { window_.clear(); }
 
 Eigen::Vector3d OdometrySmoother::gravityWorld() const {
   return gravityFromTilt(tilt_.data(), options_.gravity_world);

@@ -27,6 +27,7 @@ MotionPrediction ConstantVelocityPrior::predict(const io::Scan& scan) {
   MotionPrediction prediction;
   prediction.T_odom_body = predictedAt(scan.t_end_s);
   prediction.sweep_T_odom_body = sweepPoses(scan, predictedAt);
+  prediction.constant_velocity = true;
   predicted_ = Twist{scan.t_end_s, prediction.T_odom_body};
   return prediction;
 }

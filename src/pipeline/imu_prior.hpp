@@ -46,6 +46,9 @@ class ImuPrior final : public MotionPrior {
     const Eigen::Vector2d tilt = smoother_.tilt();
     return lie::SO3::Exp(Eigen::Vector3d(-tilt.x(), -tilt.y(), 0.0));
   }
+  /// Forgets the state and starts again from the next two scans (attitude from the last second of
+  /// readings, velocity from the scans' registration), at T_odom_body's position and heading.
+  bool restart(const lie::SE3& T_odom_body) override;
 
  private:
   /// Attitude and biases from the IMU readings, and the time the state starts at.
@@ -58,8 +61,16 @@ class ImuPrior final : public MotionPrior {
   /// Levels the frame with the collected poses; returns T_levelled_unlevelled, or none when the
   /// alignment is not trusted (the IMU's attitude is kept).
   std::optional<lie::SE3> levelFrame();
+  /// The readings of the last kRestartAttitudeWindow_s before t_s.
+  std::vector<ImuSample> recentReadings(double t_s) const;
+  /// The twist from the state before the latest to the latest, per second ([rho; theta], body
+  /// frame; zero when they share a time).
+  lie::Vector6 twistPerS() const;
   /// Across a gap in the readings: the pose at t_s from the twist between the last two states.
   lie::SE3 constantVelocityAt(double t_s) const;
+  /// Across a gap in the readings: the IMU factor from the latest state to t_to_s of that twist's
+  /// rotation and a constant velocity.
+  imu::Preintegrator constantVelocityIncrement(double t_to_s, const imu::ImuNoise& noise) const;
 
   OdometryConfig config_;
   lie::SO3 R_body_imu_;
@@ -71,6 +82,9 @@ class ImuPrior final : public MotionPrior {
   std::optional<double> last_gap_end_s_;     ///< the end of the last scan predicted across a gap
   backend::OdometrySmoother smoother_;
   std::optional<io::Scan> first_scan_;  ///< held until the second scan arrives
+  /// Set by restart(): where the next start places the body (position and heading).
+  std::optional<lie::SE3> restart_T_odom_body_;
+  Eigen::Vector2d restart_tilt_ = Eigen::Vector2d::Zero();  ///< the odom frame's at the restart
   /// The scan last predicted: its end time and the increment since the previous state.
   double predicted_t_s_ = 0.0;
   std::optional<imu::Preintegrator> preintegrated_;

@@ -21,14 +21,23 @@ std::pair<imu::InitialState, double> ImuPrior::initialAttitude(const io::Scan& f
   // would tilt the whole start of the map (1.3 % end-point drift on a 15 s walk, 0.1 % without).
   // Without orientation the tilt is a mean over the readings, and more readings average better.
   constexpr std::size_t kMinReadings = 10;  // what initializeFromImu needs
-  const std::vector<ImuSample> before_first = imu_.between(imu_.firstTime(), first.t_start_s);
-  const bool before_suffices = before_first.size() >= kMinReadings &&
-                               before_first.back().t_s <= first.t_start_s &&
-                               before_first.back().orientation.has_value();
+  // A restart's buffer starts with a reading from before the loss (the one in force then): its
+  // attitude comes from the last second's readings alone, which restart() made sure exist.
+  const std::vector<ImuSample> before_first = restart_T_odom_body_
+                                                  ? recentReadings(first.t_start_s)
+                                                  : imu_.between(imu_.firstTime(), first.t_start_s);
+  const bool before_suffices =
+      before_first.size() >= kMinReadings && before_first.back().t_s <= first.t_start_s &&
+      (restart_T_odom_body_ || before_first.back().orientation.has_value());
   const imu::InitialState init = imu::initializeFromImu(before_suffices ? before_first : imu_.all(),
                                                         {.gravity_mps2 = config_.imu.gravity_mps2});
-  initialization_note_ = init.description;
-  logger().info("IMU initialization, {}", init.description);
+  if (restart_T_odom_body_) {
+    logger().info("odometry restarted at {:.3f} s, IMU attitude {}", first.t_start_s,
+                  init.description);
+  } else {
+    initialization_note_ = init.description;
+    logger().info("IMU initialization, {}", init.description);
+  }
   return {init, before_suffices ? init.t_s : first.t_start_s};
 }
 
@@ -42,6 +51,21 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
   imu::NavState at_first_start = init.state;
   at_first_start.p_world.setZero();
   at_first_start.v_world.setZero();
+  const bool restarting = restart_T_odom_body_.has_value();
+  const lie::SO3 R_odom_level =
+      lie::SO3::Exp(Eigen::Vector3d(restart_tilt_.x(), restart_tilt_.y(), 0.0));
+  const Eigen::Vector3d gravity_odom = restarting ? R_odom_level * gravity_odom_ : gravity_odom_;
+  if (restarting) {
+    // The tilt is the readings', against gravity in the odom frame as tilted as before; the
+    // position and heading are where dead reckoning had the body: the mapping graph then finds
+    // the new map segment in the map (docs/odometry.md, Health).
+    const lie::SO3 R_odom_body = R_odom_level * init.state.R_world_body;
+    const lie::SO3& R_was = restart_T_odom_body_->rotation();
+    at_first_start.R_world_body =
+        lie::SO3::fromRollPitchYaw(0.0, 0.0, R_was.yaw() - R_odom_body.yaw()) * R_odom_body;
+    at_first_start.p_world = restart_T_odom_body_->translation();
+    restart_T_odom_body_.reset();
+  }
   const double dt = second.t_end_s - first.t_end_s;
   imu::NavState at_first_end;
   PointCloud first_in_body;
@@ -52,11 +76,11 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
   for (int round = 0; round < 2; ++round) {
     const std::vector<ImuSample> readings = imu_.signalOver(t_init_s, second.t_end_s);
     const auto over_first = imu::propagateThrough(at_first_start, t_init_s, first.t_end_s, readings,
-                                                  init.bias, gravity_odom_);
+                                                  init.bias, gravity_odom);
     at_first_end = over_first.back().state;
     first_in_body = preparation_.deskewedInBody(first, imu::toTrajectory(over_first));
     const auto over_second = imu::propagateThrough(at_first_end, first.t_end_s, second.t_end_s,
-                                                   readings, init.bias, gravity_odom_);
+                                                   readings, init.bias, gravity_odom);
     const PointCloud second_in_body =
         preparation_.deskewedInBody(second, imu::toTrajectory(over_second));
     std::vector<Eigen::Vector3d> target_in_odom = preparation_.localMapPoints(first_in_body);
@@ -102,7 +126,8 @@ FirstScan ImuPrior::initialize(const io::Scan& first, const io::Scan& second) {
   }
   // A frame levelled by the IMU's attitude alone keeps estimating its tilt from the start; an
   // unlevelled one lets the loose bias absorb its gravity error until the levelling.
-  smoother_.initialize(estimate, levelled_ ? config_.gravity_tilt_sigma_deg * kRadPerDeg : 0.0);
+  smoother_.initialize(estimate, levelled_ ? config_.gravity_tilt_sigma_deg * kRadPerDeg : 0.0,
+                       restarting ? restart_tilt_ : Eigen::Vector2d::Zero());
 
   FirstScan out{.index = first.index,
                 .t_s = first.t_end_s,

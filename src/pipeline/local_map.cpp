@@ -163,6 +163,14 @@ const registration::Occupancy& LocalMap::occupancy(double voxel_m) const {
   return *in_use_.occupancy;
 }
 
+const registration::NdtTarget& LocalMap::coarseNdtTarget(double resolution_m) const {
+  std::unique_ptr<registration::NdtTarget>& target = in_use_.coarse_ndt_target;
+  if (!target || target->resolution_m() != resolution_m)
+    target = std::make_unique<registration::NdtTarget>(registration::NdtTarget::fromPoints(
+        kdTree().points(), resolution_m, ndt_cells_.cellsAt(resolution_m)));
+  return *target;
+}
+
 const registration::GicpCloud& LocalMap::gicpCloud() const {
   return inUse(in_use_.gicp_cloud, "GICP cloud");
 }

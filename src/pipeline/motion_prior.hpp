@@ -37,6 +37,10 @@ struct MotionPrediction {
   /// only), s: beyond odometry.health.max_imu_gap_s the IMU factor over it is weakened and the
   /// scan degraded.
   double imu_gap_s = 0.0;
+  /// Predicted by the twist of the last two states (lidar-only, or across a gap in the IMU
+  /// readings): off by decimetres and degrees where the body accelerates or sways, so the
+  /// registration starts with a coarse pass for its wider basin.
+  bool constant_velocity = false;
 };
 
 /// Poses over a scan's sweep every 10 ms and at its end, for the deskew's interpolation, from a
@@ -117,6 +121,10 @@ class MotionPrior {
   /// The rotation that levels the odom frame by the model's estimate of its tilt (identity
   /// when it has none).
   virtual lie::SO3 R_level_odom() const { return {}; }
+  /// The track was lost for long and the local map starts over: the state the loss left (its
+  /// velocity and tilt) is not to be trusted. True when the model starts again from the next
+  /// scans, as at its start, at T_odom_body's position and heading (IMU); false when it goes on.
+  virtual bool restart(const lie::SE3& /*T_odom_body*/) { return false; }
 };
 
 /// The IMU model, or constant velocity when `lidar_only`. `preparation` and `registration`

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "health_monitor.hpp"
 #include "lidar_factor.hpp"
@@ -163,7 +164,7 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   const bool has_map = !local_map_.empty();
   if (has_map) {
     outcome.registration =
-        registerToMap(source_cloud.positions, prediction.T_odom_body, scan.t_end_s);
+        registerToMap({source_cloud.positions, cloud_in_body.positions}, prediction, scan.t_end_s);
     const lie::Vector6 innovation =
         (prediction.T_odom_body.inverse() * outcome.registration.T_target_source).Log();
     outcome.innovation_m = innovation.head<3>().norm();
@@ -211,33 +212,51 @@ std::optional<ScanOutcome> Odometry::processScan(const io::Scan& scan) {
   return outcome;
 }
 
-registration::RegistrationResult Odometry::registerToMap(const std::vector<Eigen::Vector3d>& source,
-                                                         const lie::SE3& guess_T_odom_body,
+registration::RegistrationResult Odometry::registerToMap(const RegistrationSource& source,
+                                                         const MotionPrediction& prediction,
                                                          double t_s) {
   local_map_.beginRegistration();
-  registration::RegistrationResult result = alignToMap(source, guess_T_odom_body);
+  const lie::SE3& guess_T_odom_body = prediction.T_odom_body;
+  const std::vector<const registration::NdtTarget*> passes =
+      registration_.method == registration::Method::kGicp
+          ? std::vector<const registration::NdtTarget*>{}
+          : ndtPasses(prediction.constant_velocity);
+  registration::RegistrationResult result = alignToMap(source, guess_T_odom_body, passes);
   // The IMU predicts within centimetres, unless it has dead-reckoned for long without an ok scan
   // (no scans, or none trusted): after 4 s the prediction was 0.7 m off, and NDT's 0.5 m cells
   // settled 0.4 m from the truth, a scan the monitor still called ok.
   if (!lidar_only_ && health_->sinceOk_s(t_s) < kImuBlindBeforeWideBasin_s) return result;
-  return wide_basin_->widen(source, guess_T_odom_body, std::move(result), local_map_, *health_,
-                            [&](const lie::SE3& guess) { return alignToMap(source, guess); });
+  return wide_basin_->widen(
+      source.points, guess_T_odom_body, std::move(result), local_map_, *health_,
+      [&](const lie::SE3& guess) { return alignToMap(source, guess, passes); });
 }
 
-registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::Vector3d>& source,
-                                                      const lie::SE3& guess_T_odom_body) const {
+std::vector<const registration::NdtTarget*> Odometry::ndtPasses(bool constant_velocity) const {
+  std::vector<const registration::NdtTarget*> passes = local_map_.ndtTargets();
+  // Across a 1 s gap in a handheld's IMU readings, the twist of the last states predicted the
+  // sway degrees off; the 0.5 m cells alone then settled ever farther off, lost the track and
+  // diverged by tens of metres on 2 of 8 `harsh` seeds (docs/odometry.md, Health).
+  const double coarse_m = config_.coarsestNdtResolutionM();
+  if (constant_velocity && passes.size() == 1 && coarse_m > passes.front()->resolution_m())
+    passes.insert(passes.begin(), &local_map_.coarseNdtTarget(coarse_m));
+  return passes;
+}
+
+registration::RegistrationResult Odometry::alignToMap(
+    const RegistrationSource& source, const lie::SE3& guess_T_odom_body,
+    const std::vector<const registration::NdtTarget*>& ndt_passes) const {
   registration::RegistrationResult result;
   if (registration_.method == registration::Method::kGicp) {
-    result = registration::alignGicp(registration::GicpCloud(source, {}), local_map_.gicpCloud(),
-                                     guess_T_odom_body, registration_.gicp);
+    result = registration::alignGicp(registration::GicpCloud(source.points, {}),
+                                     local_map_.gicpCloud(), guess_T_odom_body, registration_.gicp);
   } else {
     // Coarse to fine: each pass starts from the previous one's pose.
     lie::SE3 guess = guess_T_odom_body;
     int iterations = 0;
-    for (const registration::NdtTarget* target : local_map_.ndtTargets()) {
+    for (const registration::NdtTarget* target : ndt_passes) {
       result = registration_.method == registration::Method::kD2dNdt
-                   ? registration::alignD2dNdt(source, *target, guess, registration_.ndt)
-                   : registration::alignNdt(source, *target, guess, registration_.ndt);
+                   ? registration::alignD2dNdt(source.unfiltered, *target, guess, registration_.ndt)
+                   : registration::alignNdt(source.points, *target, guess, registration_.ndt);
       iterations += result.iterations;
       if (result.num_inliers == 0) break;
       guess = result.T_target_source;
@@ -246,8 +265,8 @@ registration::RegistrationResult Odometry::alignToMap(const std::vector<Eigen::V
   }
   // Points farther than a few coarse NDT cells from the map are new ground, not misalignment.
   result.fitness_m2 =
-      registration::fitnessScore(fitnessSample(source), local_map_.kdTree(), result.T_target_source,
-                                 2.0 * config_.coarsestNdtResolutionM());
+      registration::fitnessScore(fitnessSample(source.points), local_map_.kdTree(),
+                                 result.T_target_source, 2.0 * config_.coarsestNdtResolutionM());
   return result;
 }
 
@@ -275,8 +294,14 @@ void Odometry::judgeHealth(ScanOutcome& outcome, bool registered) {
     health_->localMapRestarted(outcome.t_s);
     wide_basin_->forget();
     ++map_segment_;
-    logger().warn("scan {} at {:.3f} s: lost for long, the local map starts over (segment {})",
-                  outcome.scan_index, outcome.t_s, map_segment_);
+    // The state the loss left is not trusted either: with an IMU the motion model starts again
+    // from the next two scans, and the new map from the first of them, not from this scan, which
+    // was deskewed with that state. Started from it, a 2 s gap in the IMU readings left 4 m/s and
+    // 12 deg of tilt in the new segment, which diverged by 70 m (docs/odometry.md, Health).
+    motion_restarted_ = motion_->restart(outcome.T_odom_body);
+    logger().warn("scan {} at {:.3f} s: lost for long, the local map starts over (segment {}{})",
+                  outcome.scan_index, outcome.t_s, map_segment_,
+                  motion_restarted_ ? ", the odometry from the next two scans" : "");
   }
   outcome.map_segment = map_segment_;
 }
@@ -292,6 +317,7 @@ void Odometry::maybeAddKeyframe(ScanOutcome& outcome, PointCloud&& cloud_in_body
   // A scan the monitor distrusts never enters the map, but an empty map takes the next scan
   // whatever its status: there is nothing else to register to.
   if (outcome.health.status != ScanStatus::kOk && !local_map_.empty()) return;
+  if (std::exchange(motion_restarted_, false)) return;  // the restart's first scan starts the map
   if (fromLastKeyframe_m(outcome.T_odom_body) < config_.keyframe_distance_m) return;
   outcome.keyframe_id = keyframes_made_++;
   last_keyframe_T_odom_body_ = outcome.T_odom_body;

@@ -71,5 +71,53 @@ TEST(LocalMap, ReposingInPlaceKeepsTheMap) {
   EXPECT_LT((registerFrom(map, corner, guess).translation() - before.translation()).norm(), 1e-9);
 }
 
+// Upright poles of 10 cm radius on a 3 m grid, over a floor: a scene whose fine cells are narrow
+// basins horizontally.
+std::vector<Eigen::Vector3d> polesOnAFloor() {
+  std::vector<Eigen::Vector3d> points;
+  for (double x = 0.05; x < 12.0; x += 0.1)
+    for (double y = 0.05; y < 12.0; y += 0.1) points.emplace_back(x, y, 0.0);
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      // Off the grid by a few decimetres, so that no shift by the spacing matches.
+      const Eigen::Vector2d centre(1.5 + 3.0 * i + 0.1 * j, 1.5 + 3.0 * j + 0.15 * i);
+      for (double z = 0.1; z < 3.0; z += 0.1)
+        for (double a = 0.0; a < 2.0 * M_PI; a += 0.2)
+          points.emplace_back(centre.x() + 0.1 * std::cos(a), centre.y() + 0.1 * std::sin(a), z);
+    }
+  }
+  return points;
+}
+
+// A map that keeps only fine cells (with an IMU) serves a guess that may be far off (across a gap
+// in the IMU readings) with coarse cells over its points: built on demand, for the map in use.
+TEST(LocalMap, CoarseCellsOverItsPointsWidenAFineMapsBasin) {
+  const std::vector<Eigen::Vector3d> scene = polesOnAFloor();
+  LocalMap map({0.5}, 0.2, 10, LocalMap::Target::kNdt);
+  map.addKeyframe(0, lie::SE3(), scene);
+  map.beginRegistration();
+  const lie::SE3 far_guess(lie::SO3::fromRollPitchYaw(0.0, 0.0, 0.2), {1.3, -1.0, 0.3});
+  registration::NdtConfig ndt;
+  ndt.resolution_m = 0.5;
+  const auto coarseToFine = [&](const lie::SE3& guess) {
+    const lie::SE3 coarse =
+        registration::alignNdt(scene, map.coarseNdtTarget(2.0), guess, ndt).T_target_source;
+    return registration::alignNdt(scene, *map.ndtTargets().back(), coarse, ndt).T_target_source;
+  };
+  const double fine_alone_m =
+      registration::alignNdt(scene, *map.ndtTargets().back(), far_guess, ndt)
+          .T_target_source.translation()
+          .norm();
+  EXPECT_GT(fine_alone_m, 0.1);
+  EXPECT_LT(coarseToFine(far_guess).translation().norm(), 0.01);
+  EXPECT_EQ(map.coarseNdtTarget(2.0).resolution_m(), 2.0);
+
+  // Moved by a repose, the coarse cells are those of the map in use, not the ones built before.
+  const lie::SE3 T_moved(lie::SO3(), {1.7, 0.0, 0.0});
+  map.repose([&](std::uint64_t, const lie::SE3&) { return T_moved; });
+  map.beginRegistration();
+  EXPECT_LT((coarseToFine(T_moved * far_guess).translation() - T_moved.translation()).norm(), 0.01);
+}
+
 }  // namespace
 }  // namespace taiga::pipeline

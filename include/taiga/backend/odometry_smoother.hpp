@@ -58,11 +58,14 @@ class OdometrySmoother {
   explicit OdometrySmoother(OdometrySmootherOptions options = {});
   ~OdometrySmoother();
 
-  /// Starts the graph with one state and its uncertainty, and the frame's tilt at zero: with
-  /// tilt_sigma_rad > 0 the tilt is estimated from then on under that prior 1-sigma, otherwise
-  /// held at zero (gravity is gravity_world).
-  void initialize(const StateEstimate& first, double tilt_sigma_rad = 0.0);
+  /// Starts the graph with one state and its uncertainty, and the frame's tilt at `tilt` (zero
+  /// at a start; what it was at a restart): with tilt_sigma_rad > 0 the tilt is estimated from
+  /// then on under that prior 1-sigma, otherwise held (at zero: gravity is gravity_world).
+  void initialize(const StateEstimate& first, double tilt_sigma_rad = 0.0,
+                  const Eigen::Vector2d& tilt = Eigen::Vector2d::Zero());
   bool initialized() const { return !window_.empty(); }
+  /// Forgets every state: initialized() is false until the next initialize().
+  void reset();
 
   /// Adds a state at t_s, joined to the newest one by the IMU readings preintegrated since then
   /// (with the newest state's bias as bias_hat), with an optional pose measurement of it; then

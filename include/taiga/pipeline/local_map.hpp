@@ -76,6 +76,10 @@ class LocalMap {
   /// The voxels (of edge voxel_m) that the kd-tree's points occupy, for the correlative search;
   /// built at the first call on the structures in use (none is built for maps never searched).
   const registration::Occupancy& occupancy(double voxel_m) const;
+  /// NDT cells of edge resolution_m over the kd-tree's points, for a first pass from a guess that
+  /// may be decimetres and degrees off (across a gap in the IMU readings) on a map whose own
+  /// cells are only fine; built at the first call on the structures in use, like occupancy().
+  const registration::NdtTarget& coarseNdtTarget(double resolution_m) const;
 
  private:
   /// Sets the NDT passes (coarse to fine, at least one); only while the map is empty.
@@ -86,6 +90,7 @@ class LocalMap {
     std::unique_ptr<registration::KdTree> kd_tree;
     mutable std::unique_ptr<registration::Occupancy> occupancy;  ///< built on demand
     mutable double occupancy_voxel_m = 0.0;
+    mutable std::unique_ptr<registration::NdtTarget> coarse_ndt_target;  ///< built on demand
   };
   SearchStructures build() const;
   /// Waits for a background build and makes it the one in use.

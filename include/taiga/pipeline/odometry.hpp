@@ -43,6 +43,7 @@ class WideBasin;
 class MotionPrior;
 class ScanPreparation;
 struct FirstScan;
+struct MotionPrediction;
 
 /// What happened to the lidar factor of a scan.
 enum class LidarFactor { kFirstScan, kUsed, kInflated, kRejected };
@@ -148,11 +149,23 @@ class Odometry {
   /// Registration to the local map of the scan ending at t_s, from the prediction and, when
   /// that looks wrong without an IMU or has dead-reckoned for long with one, from the wide
   /// basin's other starts too.
-  registration::RegistrationResult registerToMap(const std::vector<Eigen::Vector3d>& source,
-                                                 const lie::SE3& guess_T_odom_body, double t_s);
-  /// One registration from one guess, with its fitness.
-  registration::RegistrationResult alignToMap(const std::vector<Eigen::Vector3d>& source,
-                                              const lie::SE3& guess_T_odom_body) const;
+  /// A scan as the registration takes it, in the body frame.
+  struct RegistrationSource {
+    /// Voxel-filtered: NDT's and GICP's points, and the fitness's.
+    const std::vector<Eigen::Vector3d>& points;
+    /// Before the voxel filter: D2D's source cells at each pass's cell edge (the filter's 0.4 m
+    /// voxels leave one to three points in a 0.5 m cell, below min_points_per_cell).
+    const std::vector<Eigen::Vector3d>& unfiltered;
+  };
+  registration::RegistrationResult registerToMap(const RegistrationSource& source,
+                                                 const MotionPrediction& prediction, double t_s);
+  /// The local map's NDT passes, coarse to fine: with a coarse first pass after a
+  /// constant-velocity prediction, when the map's own cells are only fine (with an IMU).
+  std::vector<const registration::NdtTarget*> ndtPasses(bool constant_velocity) const;
+  /// One registration from one guess through these NDT passes (unused by GICP), with its fitness.
+  registration::RegistrationResult alignToMap(
+      const RegistrationSource& source, const lie::SE3& guess_T_odom_body,
+      const std::vector<const registration::NdtTarget*>& ndt_passes) const;
   /// How far T_odom_body is from the last keyframe by the keyframe rule (distance plus
   /// keyframe_rotation_weight_m_per_rad times the rotation), m; infinite before the first.
   double fromLastKeyframe_m(const lie::SE3& T_odom_body) const;
@@ -172,6 +185,8 @@ class Odometry {
   std::unique_ptr<WideBasin> wide_basin_;
   static constexpr double kImuBlindBeforeWideBasin_s = 1.0;
   std::uint64_t map_segment_ = 0;
+  /// Set when the local map restarted and the motion model with it: this scan is no keyframe.
+  bool motion_restarted_ = false;
   std::optional<lie::SE3> last_keyframe_T_odom_body_;
   std::uint64_t keyframes_made_ = 0;
 };
