@@ -65,8 +65,7 @@ void useOneMallocArena() {
 #endif
 }
 
-// The health monitor's verdict; the first lost stretch with its reason, since that is where a
-// user looks first.
+// A lost track's consequences: which map segments float, whether the run ended lost.
 void printLostTrack(const pipeline::HealthReport& h) {
   const std::vector<std::uint64_t> floating = h.floatingSegments();
   for (const std::uint64_t segment : floating)
@@ -80,6 +79,8 @@ void printLostTrack(const pipeline::HealthReport& h) {
   fmt::print("           scans.csv marks every scan (exit code 3)\n");
 }
 
+// The health monitor's verdict; the first lost stretch with its reason, since that is where a
+// user looks first.
 void printHealth(const pipeline::HealthReport& h) {
   fmt::print("health     {}: {} scans ok, {} degraded, {} lost; {} map segment{}\n", h.verdict(),
              h.ok, h.degraded, h.lost, h.map_segments, h.map_segments == 1 ? "" : "s");

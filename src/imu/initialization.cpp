@@ -39,10 +39,10 @@ InitialState initializeFromImu(std::span<const ImuSample> samples,
                                const InitializationConfig& config) {
   std::size_t n = 0;
   while (n < samples.size() && samples[n].t_s - samples.front().t_s <= config.window_s) ++n;
-  if (n < 10) {
+  if (n < kMinInitializationReadings) {
     throw InputError(
-        fmt::format("IMU initialization needs at least 10 readings in its first {:.2f} s, got {}",
-                    config.window_s, n));
+        fmt::format("IMU initialization needs at least {} readings in its first {:.2f} s, got {}",
+                    kMinInitializationReadings, config.window_s, n));
   }
   const std::span<const ImuSample> window = samples.first(n);
   const MeanAndStd gyro =

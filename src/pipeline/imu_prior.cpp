@@ -80,8 +80,8 @@ std::vector<ImuSample> ImuPrior::recentReadings(double t_s) const {
 
 bool ImuPrior::restart(const lie::SE3& T_odom_body) {
   // Within a gap in the readings there is no attitude to start from: the state goes on.
-  constexpr std::size_t kMinReadings = 10;  // what initializeFromImu needs
-  if (!smoother_.initialized() || recentReadings(smoother_.latest().t_s).size() < kMinReadings)
+  if (!smoother_.initialized() ||
+      recentReadings(smoother_.latest().t_s).size() < imu::kMinInitializationReadings)
     return false;
   restart_tilt_ = smoother_.tilt();  // the odom frame's, which the restart keeps
   smoother_.reset();

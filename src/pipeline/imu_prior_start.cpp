@@ -20,14 +20,13 @@ std::pair<imu::InitialState, double> ImuPrior::initialAttitude(const io::Scan& f
   // degrees within a tenth of a second, so a later reading's attitude used at the scan's start
   // would tilt the whole start of the map (1.3 % end-point drift on a 15 s walk, 0.1 % without).
   // Without orientation the tilt is a mean over the readings, and more readings average better.
-  constexpr std::size_t kMinReadings = 10;  // what initializeFromImu needs
   // A restart's buffer starts with a reading from before the loss (the one in force then): its
   // attitude comes from the last second's readings alone, which restart() made sure exist.
   const std::vector<ImuSample> before_first = restart_T_odom_body_
                                                   ? recentReadings(first.t_start_s)
                                                   : imu_.between(imu_.firstTime(), first.t_start_s);
   const bool before_suffices =
-      before_first.size() >= kMinReadings && before_first.back().t_s <= first.t_start_s &&
+      before_first.size() >= imu::kMinInitializationReadings && before_first.back().t_s <= first.t_start_s &&
       (restart_T_odom_body_ || before_first.back().orientation.has_value());
   const imu::InitialState init = imu::initializeFromImu(before_suffices ? before_first : imu_.all(),
                                                         {.gravity_mps2 = config_.imu.gravity_mps2});

@@ -15,6 +15,7 @@
 //
 // Accelerometer bias is not separable from tilt at rest and starts at zero with its prior.
 
+#include <cstddef>
 #include <span>
 #include <string>
 
@@ -43,8 +44,11 @@ struct InitialState {
   std::string description;  ///< one line for the log, e.g. "at rest: roll 1.2 deg, pitch -0.4 deg"
 };
 
+/// The fewest readings initializeFromImu takes.
+inline constexpr std::size_t kMinInitializationReadings = 10;
+
 /// Uses the readings within config.window_s of the first one. Throws InputError when there are
-/// fewer than 10 readings in the window or the specific force is far from gravity (a wrong unit).
+/// fewer than kMinInitializationReadings in the window or the specific force is far from gravity (a wrong unit).
 InitialState initializeFromImu(std::span<const ImuSample> samples,
                                const InitializationConfig& config = {});
 
