@@ -6,7 +6,8 @@
 //                                          the keyframes behind it at their true poses: the mean
 //                                          error along the direction of travel is the bias
 //   registration_bias SIM --odometry       a bare lidar-only odometry (map from its own
-//                                          estimates): its Sim(3) scale against the truth
+//                                          estimates): its Sim(3) scale and path length ratio
+//                                          against the truth
 //   registration_bias SIM --scene-check    are the deskewed points and groundtruth.tum exact?
 //
 // SIM is a `taiga simulate` output directory. Keyframes every metre, source points in 0.4 m
@@ -29,6 +30,7 @@
 #include "taiga/core/angles.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/core/trajectory.hpp"
+#include "taiga/eval/drift.hpp"
 #include "taiga/io/config_yaml.hpp"
 #include "taiga/io/recording.hpp"
 #include "taiga/io/trajectory_io.hpp"
@@ -402,10 +404,18 @@ void runOdometry(const Options& o, const std::vector<TrueScan>& scans) {
     truth.col(i) = scans[i].T_world_body.translation();
   }
   const Eigen::Matrix4d sim3 = Eigen::umeyama(estimate, truth, true);
+  // The Sim(3) scale of an open trajectory also answers to its heading drift; the path length
+  // ratio does not (eval/drift.hpp).
+  std::vector<StampedPose> estimate_poses, true_poses;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    estimate_poses.push_back({0.1 * static_cast<double>(i), T_world_body_estimate[i]});
+    true_poses.push_back({0.1 * static_cast<double>(i), scans[i].T_world_body});
+  }
   std::printf("%s odometry, %.2f m cells (coarse %.2f m), %d keyframes in the map: %zu scans, "
-              "%zu keyframes, Sim(3) scale %.5f\n",
+              "%zu keyframes, Sim(3) scale %.5f, path length ratio %.5f\n",
               o.method.c_str(), o.resolution_m, o.coarse_resolution_m, o.num_keyframes,
-              scans.size(), keyframes.size(), std::cbrt(sim3.topLeftCorner<3, 3>().determinant()));
+              scans.size(), keyframes.size(), std::cbrt(sim3.topLeftCorner<3, 3>().determinant()),
+              eval::computeDrift(estimate_poses, true_poses).path_length_ratio);
 }
 
 /// groundtruth.tum against the regenerated motion, and the deskewed points (true poses) against

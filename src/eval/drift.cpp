@@ -13,6 +13,21 @@
 
 namespace taiga::eval {
 
+namespace {
+double pathLengthRatio(const std::vector<StampedPose>& est, const std::vector<StampedPose>& ref) {
+  double est_m = 0.0, ref_m = 0.0;
+  std::size_t last = 0;
+  for (std::size_t i = 1; i < ref.size(); ++i) {
+    const double step_m = (ref[i].pose.translation() - ref[last].pose.translation()).norm();
+    if (step_m < DriftResult::kPathStep_m) continue;
+    ref_m += step_m;
+    est_m += (est[i].pose.translation() - est[last].pose.translation()).norm();
+    last = i;
+  }
+  return ref_m > 0.0 ? est_m / ref_m : 0.0;
+}
+}  // namespace
+
 DriftResult computeDrift(const std::vector<StampedPose>& est, const std::vector<StampedPose>& ref) {
   assert(est.size() == ref.size());
   DriftResult result;
@@ -39,6 +54,7 @@ DriftResult computeDrift(const std::vector<StampedPose>& est, const std::vector<
         (ref[i].pose.translation() - ref[i - 1].pose.translation()).norm();
   if (result.reference_path_length_m > 0.0)
     result.drift_percent = result.drift_m / result.reference_path_length_m * 100.0;
+  result.path_length_ratio = pathLengthRatio(est, ref);
   return result;
 }
 

@@ -101,6 +101,7 @@ std::string formatEvalJson(const EvalReport& report) {
                 {"drift_vector_m", detail::vectorJson(r.drift.drift_vector_m)},
                 {"reference_path_length_m", r.drift.reference_path_length_m},
                 {"drift_percent", r.drift.drift_percent},
+                {"path_length_ratio", r.drift.path_length_ratio},
                 {"heading_aligned_drift_vector_m",
                  detail::vectorJson(r.drift.heading_aligned_drift_vector_m)}};
   const DistanceDistribution& d = r.distance;

@@ -71,6 +71,9 @@ std::vector<ValueRow> valueRows(const EvalReport& report) {
   rows.push_back({"End-point drift (% of path)",
                   fmt::format("{:.4f} (reference path {:.3f} m)", r.drift.drift_percent,
                               r.drift.reference_path_length_m)});
+  rows.push_back({"Path length ratio (est / ref)",
+                  fmt::format("{:.6f} (over steps of at least {:.0f} m of the reference)",
+                              r.drift.path_length_ratio, DriftResult::kPathStep_m)});
   const Eigen::Vector3d& heading = r.drift.heading_aligned_drift_vector_m;
   rows.push_back({"End-point drift, heading aligned (m)",
                   fmt::format("dx {:.6f}, dy {:.6f}, dz {:.6f}; first poses aligned in position "

@@ -174,6 +174,27 @@ TEST(Drift, EndPointErrorAfterAligningTheFirstPose) {
   EXPECT_NEAR(d.drift_percent, 5.0, 1e-9);
 }
 
+TEST(Drift, PathLengthRatioIsTheStepsScaleWhateverTheFrameAndThePoseNoise) {
+  const std::vector<StampedPose> ref = test::curvedPath(200);  // 0.5 m steps
+  std::vector<StampedPose> est = ref;
+  for (StampedPose& p : est) p.pose = lie::SE3(p.pose.rotation(), 0.999 * p.pose.translation());
+  est = test::transformed(lie::SE3(lie::SO3::Exp({0.1, 0.2, 0.3}), {5.0, -2.0, 1.0}), est);
+  EXPECT_NEAR(computeDrift(est, ref).path_length_ratio, 0.999, 1e-9);
+
+  // Poses 5 mm to either side in turn: a sum over every 0.5 m step would be 2e-4 too long, over
+  // steps of 1.5 m (every third pose: 1 m or more) 2.2e-5.
+  std::vector<StampedPose> noisy = ref;
+  for (std::size_t i = 0; i < noisy.size(); ++i) {
+    const Eigen::Vector3d side = noisy[i].pose.rotation() * Eigen::Vector3d::UnitY();
+    noisy[i].pose = lie::SE3(noisy[i].pose.rotation(),
+                             noisy[i].pose.translation() + (i % 2 ? 0.005 : -0.005) * side);
+  }
+  EXPECT_NEAR(computeDrift(noisy, ref).path_length_ratio, 1.0, 3e-5);
+
+  const std::vector<StampedPose> standing = test::straightLine(10, 0.05);  // 0.45 m in all
+  EXPECT_EQ(computeDrift(standing, standing).path_length_ratio, 0.0);
+}
+
 TEST(Drift, HeadingAlignedDriftIgnoresTheFirstPosesTiltButNotAWorldTilt) {
   // 100 m along x, exact, in a frame turned by 30 deg about z and shifted; only the first pose's
   // attitude is 1 deg off in pitch. Aligned on that pose, the end point is 1.75 m off in z; with

@@ -21,12 +21,20 @@ namespace taiga::eval {
 /// taiga's: an error in the first pose's roll and pitch then does not turn into a drift growing
 /// with the distance from the start (0.5 deg: 0.9 m at 100 m), while a tilted world frame still
 /// does.
+/// `path_length_ratio`: the estimate's path length over the reference's, both summed over the
+/// associated poses at which the reference has moved at least kPathStep_m since the previous one
+/// (so that pose noise, which lengthens a path of short steps, stays out). Unlike a Sim(3) scale,
+/// which an open trajectory's heading drift also moves, it measures whether the estimate's
+/// steps are too short or too long: a loop closure cannot change it (bench/BENCHMARK.md,
+/// "Session 66").
 struct DriftResult {
+  static constexpr double kPathStep_m = 1.0;
   Eigen::Vector3d drift_vector_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d heading_aligned_drift_vector_m = Eigen::Vector3d::Zero();
   double drift_m = 0.0;
   double reference_path_length_m = 0.0;
   double drift_percent = 0.0;  ///< 0 when the reference path length is 0
+  double path_length_ratio = 0.0;  ///< 0 when the reference never moves kPathStep_m
 };
 
 DriftResult computeDrift(const std::vector<StampedPose>& est, const std::vector<StampedPose>& ref);
