@@ -25,6 +25,7 @@
 #include <random>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "taiga/core/angles.hpp"
@@ -297,14 +298,18 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
   const char* kClasses[] = {
       "ground (|n_z| > 0.8)", "upright (|n_z| < 0.3)",  "other",        "range < 5 m",
       "range 5-10 m",         "range 10-20 m",          "range > 20 m", "in stem cells",
-      "upright, other, stem", "upright, other, no stem"};
-  constexpr int kNumClasses = 10;
+      "upright, other, stem", "upright, other, no stem",
+      // upright, other, stem by the stem gate their cell fails
+      "  (passes)", "  few points", "  leaning or flat", "  no circle", "  radius", "  residual",
+      "  short arc"};
+  constexpr int kNumClasses = 17;
   std::vector<double> along_m[kNumClasses], up_m[kNumClasses], total_along_m, total_up_m;
   registration::NdtConfig ndt;
   ndt.resolution_m = o.resolution_m;
   ndt.stem_cells = o.stem_cells;
   ndt.stem_cells_across_borders = o.stem_cells_across_borders;
   std::size_t num_points = 0, num_upright = 0, num_stem = 0;
+  std::size_t gate_counts[7] = {0, 0, 0, 0, 0, 0, 0};
   for (std::size_t i = 1; i + 1 < scans.size(); i += o.every) {
     std::vector<std::size_t> chosen;
     for (std::size_t k : keyframes)
@@ -316,9 +321,14 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
     const TrueScan& scan = scans[i];
     const Eigen::Vector3d forward = forwardOf(scans, i);
     if (forward.isZero()) continue;
-    const auto target = registration::NdtTarget::fromPoints(
-        mapInWorld(scans, chosen, T_world_keyframe, scan.T_world_body.translation(), 180.0),
-        o.resolution_m, ndt);
+    const std::vector<Eigen::Vector3d> map_points =
+        mapInWorld(scans, chosen, T_world_keyframe, scan.T_world_body.translation(), 180.0);
+    const auto target = registration::NdtTarget::fromPoints(map_points, o.resolution_m, ndt);
+    // Which stem gate the cells of near-stem points outside stem cells fail.
+    registration::VoxelStatistics statistics(o.resolution_m, true);
+    statistics.add(map_points);
+    std::unordered_map<registration::VoxelKey, registration::CellMoments> moments_of;
+    for (const registration::CellMoments& m : statistics.moments()) moments_of[m.key] = m;
     std::vector<Eigen::Vector3d> by_class[kNumClasses];
     for (const Eigen::Vector3d& p : scan.source_in_body) {
       const registration::NdtCell* cells[7];
@@ -331,7 +341,14 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
       by_class[r < 5 ? 3 : r < 10 ? 4 : r < 20 ? 5 : 6].push_back(p);
       if (cells[0]->stem) by_class[7].push_back(p);
       if (n_z < 0.3 && !cells[0]->stem) {
-        by_class[distanceToStem(stems, q) < 0.1 ? 8 : 9].push_back(p);
+        const bool near_stem = distanceToStem(stems, q) < 0.1;
+        by_class[near_stem ? 8 : 9].push_back(p);
+        const auto found = moments_of.find(registration::voxelOf(q, 1.0 / o.resolution_m));
+        if (near_stem && found != moments_of.end()) {
+          const int gate = static_cast<int>(registration::stemGateOf(found->second, o.resolution_m));
+          ++gate_counts[gate];
+          by_class[10 + gate].push_back(p);
+        }
       }
       ++num_points;
       if (n_z < 0.3) ++num_upright;
@@ -365,6 +382,11 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
                 1e3 * mean(up_m[c]));
   std::printf("  %zu source points in cells, %zu in upright ones, %zu in stem cells\n",
               num_points, num_upright, num_stem);
+  const char* kGates[] = {"passes (a neighbour's cell)", "few points", "leaning or flat",
+                          "no circle", "radius", "residual", "short arc"};
+  std::printf("  upright, other, stem: the gate their cell fails:");
+  for (int g = 0; g < 7; ++g) std::printf(" %s %zu;", kGates[g], gate_counts[g]);
+  std::printf("\n");
 }
 
 /// A lidar-only odometry with exact deskew: prediction from the true relative motion, a map of

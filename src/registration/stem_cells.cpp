@@ -124,30 +124,41 @@ struct StemCircle {
   double residual_variance_m2 = 0.0;
 };
 
-/// The circle of a section's moments when it passes the stem gates (fitStemSection).
-std::optional<StemCircle> stemCircle(const CellMoments& m, double resolution_m) {
+/// The circle of a section's moments and the first gate of fitStemSection it fails (kStem: none).
+struct GatedCircle {
+  StemGate gate = StemGate::kStem;
+  StemCircle circle;
+};
+GatedCircle gatedCircle(const CellMoments& m, double resolution_m) {
   constexpr std::size_t kMinPoints = 10;
   constexpr double kMinRadius_m = 0.03;
   constexpr double kMaxRadiusShare = 0.5;  // of the cell edge
   constexpr double kMinArcSpread = 0.15;   // largest horizontal variance / R^2: about 80 deg
   constexpr double kMaxLean = 0.25;        // horizontal drift of the section per m of height
-  if (m.count < kMinPoints) return std::nullopt;
+  if (m.count < kMinPoints) return {StemGate::kFewPoints};
   const double n = static_cast<double>(m.count);
   const Eigen::Matrix3d C = m.covariance * ((n - 1.0) / n);
   const double var_z = C(2, 2);
-  if (!(var_z > 0.0)) return std::nullopt;
-  if (std::hypot(C(0, 2), C(1, 2)) / var_z > kMaxLean) return std::nullopt;
+  if (!(var_z > 0.0)) return {StemGate::kLeaning};
+  if (std::hypot(C(0, 2), C(1, 2)) / var_z > kMaxLean) return {StemGate::kLeaning};
   Circle circle;
-  if (!taubin(C(0, 0), C(1, 1), C(0, 1), m.xw, m.yw, m.ww, circle)) return std::nullopt;
+  if (!taubin(C(0, 0), C(1, 1), C(0, 1), m.xw, m.yw, m.ww, circle)) return {StemGate::kNoCircle};
   const double r = circle.radius_m;
-  if (!(r >= kMinRadius_m && r <= kMaxRadiusShare * resolution_m)) return std::nullopt;
+  if (!(r >= kMinRadius_m && r <= kMaxRadiusShare * resolution_m)) return {StemGate::kRadius};
   const Eigen::Vector2d centre = m.mean.head<2>() + circle.centre_from_mean;
   const double residual_variance_m2 = residualVariance(m, centre, r);
-  if (!liesOnCircle(residual_variance_m2, r)) return std::nullopt;
+  if (!liesOnCircle(residual_variance_m2, r)) return {StemGate::kResidual};
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(C.topLeftCorner<2, 2>(),
                                                                    Eigen::EigenvaluesOnly);
-  if (horizontal.eigenvalues()(1) < kMinArcSpread * r * r) return std::nullopt;
-  return StemCircle{centre, r, residual_variance_m2};
+  if (horizontal.eigenvalues()(1) < kMinArcSpread * r * r) return {StemGate::kShortArc};
+  return {StemGate::kStem, StemCircle{centre, r, residual_variance_m2}};
+}
+
+/// The circle of a section's moments when it passes the stem gates (fitStemSection).
+std::optional<StemCircle> stemCircle(const CellMoments& m, double resolution_m) {
+  const GatedCircle gated = gatedCircle(m, resolution_m);
+  if (gated.gate != StemGate::kStem) return std::nullopt;
+  return gated.circle;
 }
 
 void makeStemCell(const StemCircle& circle, double min_variance_m2, NdtCell& cell) {
@@ -168,6 +179,10 @@ bool fitStemSection(const CellMoments& m, double resolution_m, double min_varian
   if (!circle) return false;
   makeStemCell(*circle, min_variance_m2, cell);
   return true;
+}
+
+StemGate stemGateOf(const CellMoments& m, double resolution_m) {
+  return gatedCircle(m, resolution_m).gate;
 }
 
 bool fitStemSectionAcross(const CellMoments& own, std::span<const CellMoments* const> block,

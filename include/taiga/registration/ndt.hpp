@@ -113,6 +113,10 @@ struct NdtCell {
 /// Gaussian either way.
 bool fitStemSection(const CellMoments& m, double resolution_m, double min_variance_m2,
                     NdtCell& cell);
+/// Which of fitStemSection's gates a cell's section fails first (kStem: none), for diagnosis
+/// (bench/registration_bias --forces).
+enum class StemGate { kStem, kFewPoints, kLeaning, kNoCircle, kRadius, kResidual, kShortArc };
+StemGate stemGateOf(const CellMoments& m, double resolution_m);
 /// A stem cut by cell borders: the circle of the section of a block of cells (`own` among them)
 /// under the same gates, when `own`'s points lie on it as closely as the gates ask.
 bool fitStemSectionAcross(const CellMoments& own, std::span<const CellMoments* const> block,
