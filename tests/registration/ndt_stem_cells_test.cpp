@@ -108,6 +108,19 @@ TEST(NdtStemCells, WallsBlobsAndShortArcsAreNotStems) {
   const NdtTarget target = NdtTarget::fromPoints(short_arc, 0.5, config);
   ASSERT_EQ(target.cells().size(), 1u);
   EXPECT_FALSE(target.cells()[0].stem);
+
+  // Which gate each fails (stemGateOf, a diagnosis); a 140 deg arc passes, 9 points do not.
+  const auto gateOf = [](const std::vector<Eigen::Vector3d>& points) {
+    VoxelStatistics statistics(0.5, true);
+    statistics.add(points);
+    return stemGateOf(statistics.moments().at(0), 0.5);
+  };
+  EXPECT_EQ(gateOf(wall), StemGate::kNoCircle);  // a straight section
+  EXPECT_EQ(gateOf(blob), StemGate::kResidual);
+  EXPECT_EQ(gateOf(short_arc), StemGate::kShortArc);
+  const auto stem = arc({3.25, 1.25}, 0.12, {0.0, 0.0}, 1.22, 0.5, 0.005, rng);
+  EXPECT_EQ(gateOf(stem), StemGate::kStem);
+  EXPECT_EQ(gateOf({stem.begin(), stem.begin() + 9}), StemGate::kFewPoints);
 }
 
 TEST(NdtStemCells, ABlocksCircleIsTheCircleOfItsPooledPoints) {
