@@ -70,9 +70,14 @@ struct Options {
   /// Each voxel's point: centroid, measured (the return nearest the centroid) or raw (no voxels).
   std::string source_sample = "centroid", map_sample = "centroid";
   double source_noise_m = 0.0, map_noise_m = 0.0;  ///< added 1-sigma range noise (diagnosis)
+  /// > 0: the map's stem cells know this range noise (sigma_m + per_m x range) along the beams.
+  double beam_sigma_m = 0.0, beam_sigma_per_m = 0.0;
   bool reverse = false;  ///< also register the map (as source) to the scan (as target)
   bool stem_cells = false;  ///< NdtConfig::stem_cells
   bool stem_cells_across_borders = false;  ///< NdtConfig::stem_cells_across_borders
+  /// Diagnosis: the map points from this recording instead (the same simulation with other
+  /// lidar settings, e.g. without noise: what a noise-free map would give).
+  std::string map_from;
 };
 
 struct TrueScan {
@@ -137,7 +142,8 @@ std::vector<Eigen::Vector3d> mapInWorld(const std::vector<TrueScan>& scans,
                                         const std::vector<std::size_t>& keyframes,
                                         const std::vector<lie::SE3>& T_world_keyframe,
                                         const Eigen::Vector3d& viewpoint_world,
-                                        double max_view_angle_deg) {
+                                        double max_view_angle_deg,
+                                        std::vector<Eigen::Vector3d>* sensors = nullptr) {
   const double min_cos = std::cos(max_view_angle_deg * kRadPerDeg);
   std::vector<Eigen::Vector3d> points;
   for (std::size_t j = 0; j < keyframes.size(); ++j) {
@@ -148,14 +154,34 @@ std::vector<Eigen::Vector3d> mapInWorld(const std::vector<TrueScan>& scans,
           (q - T.translation()).normalized().dot((q - viewpoint_world).normalized()) < min_cos)
         continue;
       points.push_back(q);
+      if (sensors != nullptr) sensors->push_back(T.translation());
     }
   }
   return points;
 }
 
+/// The fine NDT target; with --beam-noise its stem cells take the map points' range noise out
+/// (VoxelStatistics::add with BeamNoise; the body origin stands for the lidar's).
+registration::NdtTarget fineTarget(const Options& o, const std::vector<Eigen::Vector3d>& map,
+                                   const std::vector<Eigen::Vector3d>* sensors,
+                                   const registration::NdtConfig& ndt) {
+  if (o.beam_sigma_m <= 0.0 || sensors == nullptr || !ndt.stem_cells)
+    return registration::NdtTarget::fromPoints(map, o.resolution_m, ndt);
+  registration::VoxelStatistics statistics(o.resolution_m, true);
+  for (std::size_t begin = 0; begin < map.size();) {
+    std::size_t end = begin;
+    while (end < map.size() && (*sensors)[end] == (*sensors)[begin]) ++end;
+    statistics.add(std::span(map).subspan(begin, end - begin),
+                   {(*sensors)[begin], o.beam_sigma_m, o.beam_sigma_per_m});
+    begin = end;
+  }
+  return registration::NdtTarget(statistics, ndt);
+}
+
 registration::RegistrationResult align(const Options& o, std::span<const Eigen::Vector3d> source,
                                        const std::vector<Eigen::Vector3d>& map_in_world,
-                                       const lie::SE3& guess) {
+                                       const lie::SE3& guess,
+                                       const std::vector<Eigen::Vector3d>* sensors = nullptr) {
   registration::NdtConfig ndt;
   ndt.resolution_m = o.resolution_m;
   ndt.stem_cells = o.stem_cells;
@@ -170,7 +196,7 @@ registration::RegistrationResult align(const Options& o, std::span<const Eigen::
                 guess, ndt)
                 .T_target_source;
   }
-  const auto target = registration::NdtTarget::fromPoints(map_in_world, o.resolution_m, ndt);
+  const auto target = fineTarget(o, map_in_world, sensors, ndt);
   return o.method == "d2d" ? registration::alignD2dNdt(source, target, start, ndt)
                            : registration::alignNdt(source, target, start, ndt);
 }
@@ -321,9 +347,10 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
     const TrueScan& scan = scans[i];
     const Eigen::Vector3d forward = forwardOf(scans, i);
     if (forward.isZero()) continue;
-    const std::vector<Eigen::Vector3d> map_points =
-        mapInWorld(scans, chosen, T_world_keyframe, scan.T_world_body.translation(), 180.0);
-    const auto target = registration::NdtTarget::fromPoints(map_points, o.resolution_m, ndt);
+    std::vector<Eigen::Vector3d> sensors;
+    const std::vector<Eigen::Vector3d> map_points = mapInWorld(
+        scans, chosen, T_world_keyframe, scan.T_world_body.translation(), 180.0, &sensors);
+    const auto target = fineTarget(o, map_points, &sensors, ndt);
     // Which stem gate the cells of near-stem points outside stem cells fail.
     registration::VoxelStatistics statistics(o.resolution_m, true);
     statistics.add(map_points);
@@ -394,7 +421,7 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
 void runOdometry(const Options& o, const std::vector<TrueScan>& scans) {
   std::vector<lie::SE3> T_world_body_estimate{scans[0].T_world_body};
   std::vector<std::size_t> keyframes{0};
-  std::vector<Eigen::Vector3d> map_in_world;
+  std::vector<Eigen::Vector3d> map_in_world, sensors;
   bool map_stale = true;
   for (std::size_t i = 1; i < scans.size(); ++i) {
     const lie::SE3 guess = T_world_body_estimate.back() *
@@ -409,11 +436,13 @@ void runOdometry(const Options& o, const std::vector<TrueScan>& scans) {
       for (std::size_t k : in_map) T_world_keyframe.push_back(T_world_body_estimate[k]);
       const Eigen::Vector3d viewpoint =
           (view_per_scan ? guess : T_world_body_estimate[keyframes.back()]).translation();
-      map_in_world = mapInWorld(scans, in_map, T_world_keyframe, viewpoint, o.max_view_angle_deg);
+      sensors.clear();
+      map_in_world =
+          mapInWorld(scans, in_map, T_world_keyframe, viewpoint, o.max_view_angle_deg, &sensors);
       map_stale = false;
     }
     T_world_body_estimate.push_back(
-        align(o, scans[i].source_in_body, map_in_world, guess).T_target_source);
+        align(o, scans[i].source_in_body, map_in_world, guess, &sensors).T_target_source);
     const Eigen::Vector3d last_keyframe = T_world_body_estimate[keyframes.back()].translation();
     if ((T_world_body_estimate.back().translation() - last_keyframe).norm() >= 1.0) {
       keyframes.push_back(i);
@@ -499,6 +528,10 @@ int main(int argc, char** argv) {
                  "centroid | measured | bearing | raw (0.4 m voxels)");
   app.add_option("--map-sample", o.map_sample,
                  "centroid | measured | bearing | raw (0.2 m voxels)");
+  app.add_option("--beam-noise", o.beam_sigma_m,
+                 "stem cells take out this range noise of the map points, 1-sigma m");
+  app.add_option("--beam-noise-per-m", o.beam_sigma_per_m, "and this much more per metre");
+  app.add_option("--map-from", o.map_from, "map points from this simulation (diagnosis)");
   app.add_option("--source-noise", o.source_noise_m, "add range noise to the source, 1-sigma m");
   app.add_option("--map-noise", o.map_noise_m, "add range noise to the map points, 1-sigma m");
   app.add_flag("--stem-cells", o.stem_cells, "NDT stem cells (ndt.hpp)");
@@ -514,7 +547,18 @@ int main(int argc, char** argv) {
   SystemConfig config;
   io::readConfigYaml(o.sim_dir + "/rig.yaml", config);
   const Trajectory truth = io::readTum(o.sim_dir + "/groundtruth.tum");
-  const std::vector<TrueScan> scans = readTrueScans(o, config, truth);
+  std::vector<TrueScan> scans = readTrueScans(o, config, truth);
+  if (!o.map_from.empty()) {
+    Options other = o;
+    other.sim_dir = o.map_from;
+    const std::vector<TrueScan> map_scans = readTrueScans(other, config, truth);
+    if (map_scans.size() != scans.size()) {
+      std::fprintf(stderr, "%s: %zu scans against %zu\n", o.map_from.c_str(), map_scans.size(),
+                   scans.size());
+      return 1;
+    }
+    for (std::size_t i = 0; i < scans.size(); ++i) scans[i].map_in_body = map_scans[i].map_in_body;
+  }
   if (scans.size() < 3) {
     std::fprintf(stderr, "%s: fewer than 3 scans within the ground truth\n", o.sim_dir.c_str());
     return 1;

@@ -109,6 +109,15 @@ void OdometryConfig::visit(ConfigVisitor& v) {
           "true: a cell whose own part of a stem is too short for a circle takes the circle of a "
           "2 x 2 block of cells around it (a stem cut by cell borders; slightly less shrink, but "
           "IMU-gap bridging diverged with it; docs/registration.md, Bias)");
+  v.field("ndt_stem_cells_range_noise", ndt_stem_cells_range_noise,
+          "true: the stem cells' circles are fitted with the local map's range noise "
+          "(lidar_range_sigma_m, lidar_range_sigma_per_m) taken out along each point's beam "
+          "(docs/registration.md, Range noise in the stem cells)");
+  v.field("lidar_range_sigma_m", lidar_range_sigma_m,
+          "m, the lidar's range noise (1-sigma) near the sensor, as its datasheet's precision");
+  v.field("lidar_range_sigma_per_m", lidar_range_sigma_per_m,
+          "the range noise's growth per metre of range (1-sigma: lidar_range_sigma_m + this x "
+          "range)");
   v.field("local_map_voxel_m", local_map_voxel_m, "m, spacing of keyframe points in the local map");
   static constexpr std::array<std::string_view, 2> kLocalMapPoints{"centroid", "bearing"};
   v.choice("local_map_point", local_map_point, kLocalMapPoints,
@@ -174,6 +183,9 @@ void OdometryConfig::validate() const {
                    "m (0: one pass)");
   }
   requireInRange("local_map_voxel_m", local_map_voxel_m, 0.01, 5.0, "m");
+  // A range noise of metres is a unit error (mm written as m), not a lidar.
+  requireInRange("lidar_range_sigma_m", lidar_range_sigma_m, 0.0, 0.5, "m");
+  requireInRange("lidar_range_sigma_per_m", lidar_range_sigma_per_m, 0.0, 0.05, "");
   requireInRange("local_map_keyframes", local_map_keyframes, 1, 1000, "keyframes");
   requirePositive("lidar_sigma", lidar_sigma, "m");
   requireNonNegative("lidar_heading_sigma_rad", lidar_heading_sigma_rad, "rad");

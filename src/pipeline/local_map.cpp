@@ -9,11 +9,12 @@ namespace taiga::pipeline {
 
 LocalMap::LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m, int max_keyframes,
                    Target target, const registration::GicpConfig& gicp,
-                   const registration::NdtConfig& ndt)
+                   const registration::NdtConfig& ndt, const Eigen::Vector3d& p_keyframe_lidar)
     : max_keyframes_(max_keyframes),
       target_(target),
       gicp_config_(gicp),
       ndt_cells_(ndt),
+      p_keyframe_lidar_(p_keyframe_lidar),
       point_statistics_(point_spacing_m) {
   setNdtResolutions(ndt_resolutions_m);
 }
@@ -60,21 +61,37 @@ void LocalMap::finishPendingBuild() {
 
 void LocalMap::account(const std::vector<const Keyframe*>& added,
                        const std::vector<const Keyframe*>& removed) {
-  auto inOdom = [](const Keyframe& keyframe) {
-    std::vector<Eigen::Vector3d> points_in_odom = keyframe.points_in_keyframe;
-    for (Eigen::Vector3d& p : points_in_odom) p = keyframe.T_odom_keyframe * p;
-    return points_in_odom;
+  struct InOdom {
+    std::vector<Eigen::Vector3d> points;
+    registration::BeamNoise beams;  ///< the keyframe's lidar and the range noise
   };
-  std::vector<std::vector<Eigen::Vector3d>> added_in_odom, removed_in_odom;
+  auto inOdom = [&](const Keyframe& keyframe) {
+    InOdom out{keyframe.points_in_keyframe,
+               {keyframe.T_odom_keyframe * p_keyframe_lidar_, ndt_cells_.range_sigma_m,
+                ndt_cells_.range_sigma_per_m}};
+    for (Eigen::Vector3d& p : out.points) p = keyframe.T_odom_keyframe * p;
+    return out;
+  };
+  std::vector<InOdom> added_in_odom, removed_in_odom;
   for (const Keyframe* keyframe : added) added_in_odom.push_back(inOdom(*keyframe));
   for (const Keyframe* keyframe : removed) removed_in_odom.push_back(inOdom(*keyframe));
   // Removal subtracts exactly what adding added: the same points through the same pose. The
   // statistics are independent and each is updated by one thread, in the same order as before.
+  // Only statistics with circle moments (the stem cells') take the beams.
+  const bool beams = ndt_cells_.range_sigma_m > 0.0 || ndt_cells_.range_sigma_per_m > 0.0;
   std::vector<registration::VoxelStatistics*> all{&point_statistics_};
   for (registration::VoxelStatistics& statistics : ndt_statistics_) all.push_back(&statistics);
   tbb::parallel_for(std::size_t{0}, all.size(), [&](std::size_t i) {
-    for (const auto& points : added_in_odom) all[i]->add(points);
-    for (const auto& points : removed_in_odom) all[i]->remove(points);
+    registration::VoxelStatistics& statistics = *all[i];
+    const bool with_beams = beams && statistics.circleMoments();
+    for (const InOdom& keyframe : added_in_odom) {
+      if (with_beams) statistics.add(keyframe.points, keyframe.beams);
+      else statistics.add(keyframe.points);
+    }
+    for (const InOdom& keyframe : removed_in_odom) {
+      if (with_beams) statistics.remove(keyframe.points, keyframe.beams);
+      else statistics.remove(keyframe.points);
+    }
   });
 }
 

@@ -91,7 +91,7 @@ Odometry::Odometry(const OdometryConfig& config, const RigConfig& rig, bool lida
                  config.local_map_keyframes,
                  registration_.method == registration::Method::kGicp ? LocalMap::Target::kGicp
                                                                      : LocalMap::Target::kNdt,
-                 registration_.gicp, registration_.ndt),
+                 registration_.gicp, registration_.ndt, rig.T_body_lidar.translation()),
       health_(std::make_unique<HealthMonitor>(config.health, config.max_fitness_m2)),
       wide_basin_(std::make_unique<WideBasin>(config)) {}
 

@@ -34,6 +34,10 @@ RegistrationConfig registrationConfigFor(const OdometryConfig& odometry) {
       odometry.ndt_neighbours == "direct1" ? NeighbourSearch::kDirect1 : NeighbourSearch::kDirect7;
   config.ndt.stem_cells = odometry.ndt_stem_cells;
   config.ndt.stem_cells_across_borders = odometry.ndt_stem_cells_across_borders;
+  if (odometry.ndt_stem_cells_range_noise) {
+    config.ndt.range_sigma_m = odometry.lidar_range_sigma_m;
+    config.ndt.range_sigma_per_m = odometry.lidar_range_sigma_per_m;
+  }
   return config;
 }
 

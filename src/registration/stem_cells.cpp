@@ -124,18 +124,41 @@ struct StemCircle {
   double residual_variance_m2 = 0.0;
 };
 
+/// The section's moments without the range noise's share (CellMoments::noise_xx ...; zero for
+/// points added without their beams): the circle is fitted to these, and its gates judge them.
+CellMoments withoutNoise(const CellMoments& m) {
+  if (m.count < 2) return m;
+  CellMoments clean = m;
+  const double n = static_cast<double>(m.count);
+  clean.covariance.topLeftCorner<2, 2>() -= m.noise_xx * (n / (n - 1.0));
+  // A stated noise larger than the section's own spread along the beams (a datasheet's
+  // worst case, or a unit error) would leave a negative variance: the section is then fitted
+  // as it was measured.
+  const Eigen::Matrix2d horizontal = clean.covariance.topLeftCorner<2, 2>();
+  if (!(horizontal(0, 0) > 0.0 && horizontal.determinant() > 0.0)) return m;
+  clean.xw -= m.noise_xw;
+  clean.yw -= m.noise_yw;
+  clean.ww -= m.noise_ww;
+  clean.noise_xx.setZero();
+  clean.noise_xw = clean.noise_yw = clean.noise_ww = 0.0;
+  return clean;
+}
+
 /// The circle of a section's moments and the first gate of fitStemSection it fails (kStem: none).
+/// The residual variance kept with the circle is the points' own (noise included): it weighs the
+/// distances of a scan's points, which are noisy too.
 struct GatedCircle {
   StemGate gate = StemGate::kStem;
   StemCircle circle;
 };
-GatedCircle gatedCircle(const CellMoments& m, double resolution_m) {
+GatedCircle gatedCircle(const CellMoments& noisy, double resolution_m) {
   constexpr std::size_t kMinPoints = 10;
   constexpr double kMinRadius_m = 0.03;
   constexpr double kMaxRadiusShare = 0.5;  // of the cell edge
   constexpr double kMinArcSpread = 0.15;   // largest horizontal variance / R^2: about 80 deg
   constexpr double kMaxLean = 0.25;        // horizontal drift of the section per m of height
-  if (m.count < kMinPoints) return {StemGate::kFewPoints};
+  if (noisy.count < kMinPoints) return {StemGate::kFewPoints};
+  const CellMoments m = withoutNoise(noisy);
   const double n = static_cast<double>(m.count);
   const Eigen::Matrix3d C = m.covariance * ((n - 1.0) / n);
   const double var_z = C(2, 2);
@@ -146,12 +169,11 @@ GatedCircle gatedCircle(const CellMoments& m, double resolution_m) {
   const double r = circle.radius_m;
   if (!(r >= kMinRadius_m && r <= kMaxRadiusShare * resolution_m)) return {StemGate::kRadius};
   const Eigen::Vector2d centre = m.mean.head<2>() + circle.centre_from_mean;
-  const double residual_variance_m2 = residualVariance(m, centre, r);
-  if (!liesOnCircle(residual_variance_m2, r)) return {StemGate::kResidual};
+  if (!liesOnCircle(residualVariance(m, centre, r), r)) return {StemGate::kResidual};
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(C.topLeftCorner<2, 2>(),
                                                                    Eigen::EigenvaluesOnly);
   if (horizontal.eigenvalues()(1) < kMinArcSpread * r * r) return {StemGate::kShortArc};
-  return {StemGate::kStem, StemCircle{centre, r, residual_variance_m2}};
+  return {StemGate::kStem, StemCircle{centre, r, residualVariance(noisy, centre, r)}};
 }
 
 /// The circle of a section's moments when it passes the stem gates (fitStemSection).

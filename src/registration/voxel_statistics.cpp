@@ -37,7 +37,11 @@ VoxelStatistics::VoxelStatistics(double resolution_m, bool circle_moments)
   }
 }
 
-void VoxelStatistics::update(const Eigen::Vector3d& p, int sign) {
+namespace {
+Int128 roundedToInt128(double value) { return static_cast<Int128>(std::llround(value)); }
+}  // namespace
+
+void VoxelStatistics::update(const Eigen::Vector3d& p, int sign, const BeamNoise* beams) {
   const VoxelKey key = voxelOf(p, inverse_resolution_);
   if (key == kInvalidVoxel) {
     if (sign > 0) ++skipped_;
@@ -70,17 +74,45 @@ void VoxelStatistics::update(const Eigen::Vector3d& p, int sign) {
     circle.xw += sign * (q[0] * w);
     circle.yw += sign * (q[1] * w);
     circle.ww += sign * (w * w);
+    if (beams != nullptr) {
+      // The noise's expected share (voxel_statistics.hpp), in quanta, from this point's x and
+      // beam; rounded alike when it is removed, so the sums stay exact.
+      const Eigen::Vector3d beam = p - beams->sensor;
+      const double range_m = beam.norm();
+      if (range_m > 0.0) {
+        const double sigma_q = (beams->sigma_m + beams->sigma_per_m * range_m) / kQuantum_m;
+        const double s2 = sigma_q * sigma_q;
+        const double ux = beam.x() / range_m, uy = beam.y() / range_m, uu = ux * ux + uy * uy;
+        const double x = static_cast<double>(q[0]), y = static_cast<double>(q[1]);
+        const double ud = ux * x + uy * y;
+        circle.noise_xx += sign * std::llround(s2 * ux * ux);
+        circle.noise_xy += sign * std::llround(s2 * ux * uy);
+        circle.noise_yy += sign * std::llround(s2 * uy * uy);
+        circle.noise_xw += sign * roundedToInt128(s2 * (uu * x + 2.0 * ud * ux));
+        circle.noise_yw += sign * roundedToInt128(s2 * (uu * y + 2.0 * ud * uy));
+        circle.noise_ww += sign * roundedToInt128(s2 * (4.0 * ud * ud + 2.0 * (x * x + y * y) * uu) -
+                                                  3.0 * s2 * s2 * uu * uu);
+      }
+    }
     if (sums.count == 0) circle_cells_.erase(key);
   }
   if (sums.count == 0) cells_.erase(it);
 }
 
 void VoxelStatistics::add(std::span<const Eigen::Vector3d> points) {
-  for (const auto& p : points) update(p, +1);
+  for (const auto& p : points) update(p, +1, nullptr);
+}
+
+void VoxelStatistics::add(std::span<const Eigen::Vector3d> points, const BeamNoise& beams) {
+  for (const auto& p : points) update(p, +1, &beams);
 }
 
 void VoxelStatistics::remove(std::span<const Eigen::Vector3d> points) {
-  for (const auto& p : points) update(p, -1);
+  for (const auto& p : points) update(p, -1, nullptr);
+}
+
+void VoxelStatistics::remove(std::span<const Eigen::Vector3d> points, const BeamNoise& beams) {
+  for (const auto& p : points) update(p, -1, &beams);
 }
 
 std::size_t VoxelStatistics::numPoints() const {
@@ -141,6 +173,22 @@ void VoxelStatistics::circleMoments(const Sums& sums, const CircleSums& circle,
   m.ww = (ww + 4.0 * (a * a * xx + b * b * yy + 2.0 * a * b * xy) - 4.0 * (a * xw + b * yw) +
           2.0 * c * w - 3.0 * c * c) *
          kM4;
+  // The noise's share about the mean: the same conversion is linear in the raw moments, so the
+  // share converts by its linear part (the mean is not changed by zero-mean noise).
+  const double nxx = static_cast<double>(circle.noise_xx) / n;
+  const double nxy = static_cast<double>(circle.noise_xy) / n;
+  const double nyy = static_cast<double>(circle.noise_yy) / n;
+  const double nxw = static_cast<double>(circle.noise_xw) / n;
+  const double nyw = static_cast<double>(circle.noise_yw) / n;
+  const double nww = static_cast<double>(circle.noise_ww) / n;
+  const double nw = nxx + nyy;
+  constexpr double kM2 = kQuantum_m * kQuantum_m;
+  m.noise_xx << nxx * kM2, nxy * kM2, nxy * kM2, nyy * kM2;
+  m.noise_xw = (nxw - a * nw - 2.0 * a * nxx - 2.0 * b * nxy) * kM3;
+  m.noise_yw = (nyw - b * nw - 2.0 * b * nyy - 2.0 * a * nxy) * kM3;
+  m.noise_ww = (nww + 4.0 * (a * a * nxx + b * b * nyy + 2.0 * a * b * nxy) -
+                4.0 * (a * nxw + b * nyw) + 2.0 * c * nw) *
+               kM4;
 }
 
 std::vector<CellMoments> VoxelStatistics::moments(std::size_t min_points) const {

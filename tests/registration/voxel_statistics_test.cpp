@@ -45,6 +45,33 @@ TEST(VoxelStatistics, AddThenRemoveEqualsNeverAdded) {
   }
 }
 
+TEST(VoxelStatistics, PointsAddedWithTheirBeamsAreRemovedExactly) {
+  const auto a = randomPoints(20000, 5, 10.0);
+  const auto b = randomPoints(5000, 6, 12.0);
+  const BeamNoise from_a{{0.3, -0.2, 1.0}, 0.01, 0.0005}, from_b{{5.0, 2.0, 1.5}, 0.02, 0.001};
+  VoxelStatistics only_a(0.5, true);
+  only_a.add(a, from_a);
+  VoxelStatistics map(0.5, true);
+  map.add(a, from_a);
+  map.add(b, from_b);
+  EXPECT_FALSE(map == only_a);
+  map.remove(b, from_b);
+  EXPECT_TRUE(map == only_a);
+  // The beams are the noise's share only: the moments themselves are those of the points.
+  VoxelStatistics without_beams(0.5, true);
+  without_beams.add(a);
+  const std::vector<CellMoments> with = only_a.moments(), without = without_beams.moments();
+  ASSERT_EQ(with.size(), without.size());
+  int with_noise_share = 0;
+  for (std::size_t i = 0; i < with.size(); ++i) {
+    EXPECT_EQ(with[i].covariance, without[i].covariance);
+    EXPECT_EQ(with[i].ww, without[i].ww);
+    EXPECT_TRUE(without[i].noise_xx.isZero());
+    if (with[i].count >= 2 && with[i].noise_xx.trace() > 0.0) ++with_noise_share;
+  }
+  EXPECT_GT(with_noise_share, 100);
+}
+
 TEST(VoxelStatistics, OrderOfAddingDoesNotMatter) {
   const auto a = randomPoints(3000, 3, 5.0);
   const auto b = randomPoints(3000, 4, 5.0);

@@ -96,6 +96,13 @@ struct OdometryConfig final : ConfigSection {
   /// took at most 0.003 % more off the shrink, and IMU-gap bridging diverged with it
   /// (docs/registration.md, "Local-map points on the surface, and stems across cell borders").
   bool ndt_stem_cells_across_borders = false;
+  /// The stem cells' circles fitted with the local map's range noise taken out (errors in
+  /// variables along each point's beam; docs/registration.md, "Range noise in the stem cells"):
+  /// the lidar's range noise, 1-sigma, lidar_range_sigma_m + lidar_range_sigma_per_m x range.
+  /// The defaults are an OS0's; a noise stated twice too large costs more than none.
+  bool ndt_stem_cells_range_noise = true;
+  double lidar_range_sigma_m = 0.01;
+  double lidar_range_sigma_per_m = 0.0005;
   double local_map_voxel_m = 0.2;          ///< keyframe points enter the local map at this spacing
   /// Which point stands for each local-map voxel of a keyframe: centroid, or bearing (the return
   /// whose direction from the lidar is nearest the centroid's: on the surface, with its range

@@ -39,10 +39,13 @@ class LocalMap {
   /// NDT cells at each of ndt_resolutions_m (coarse to fine, at least one); the kd-tree
   /// (fitness, GICP) over one point per point_spacing_m voxel, so overlapping keyframes do not
   /// multiply its size.
-  /// `ndt`: the cell rules of the NDT targets (NdtTarget; not its resolutions).
+  /// `ndt`: the cell rules of the NDT targets (NdtTarget; not its resolutions); with its range
+  /// noise set, the stem cells take it out along each point's beam from the lidar at
+  /// `p_keyframe_lidar` (the lidar's position in a keyframe's frame).
   LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m, int max_keyframes,
            Target target, const registration::GicpConfig& gicp = {},
-           const registration::NdtConfig& ndt = {});
+           const registration::NdtConfig& ndt = {},
+           const Eigen::Vector3d& p_keyframe_lidar = Eigen::Vector3d::Zero());
   ~LocalMap();
   LocalMap(const LocalMap&) = delete;  // the background build refers to this object
   LocalMap& operator=(const LocalMap&) = delete;
@@ -100,6 +103,7 @@ class LocalMap {
   Target target_;
   registration::GicpConfig gicp_config_;
   registration::NdtConfig ndt_cells_;  ///< the NDT targets' cell rules
+  Eigen::Vector3d p_keyframe_lidar_;
   struct Keyframe {
     std::uint64_t id = 0;
     lie::SE3 T_odom_keyframe;

@@ -15,8 +15,10 @@
 // Sigma^-1 = n n^T / sigma_r^2 + e_z e_z^T / sigma_z^2 with n the radial direction. A Gaussian of
 // the arc a keyframe saw sits on that keyframe's side of the stem and pulls a scan that sees
 // another arc toward the keyframe (docs/registration.md, "Bias"); the circle is the same from
-// every side. The circle is Taubin's algebraic fit to the cell's horizontal moments. Coarser
-// targets than resolution_m keep Gaussians (NdtConfig::cellsAt).
+// every side. The circle is Taubin's algebraic fit to the cell's horizontal moments, with the
+// range noise's share taken out when the points were added with their beams (voxel_statistics.hpp,
+// BeamNoise; docs/registration.md, "Range noise in the stem cells"). Coarser targets than
+// resolution_m keep Gaussians (NdtConfig::cellsAt).
 //
 // Each source point x' = T x contributes the normal-plus-uniform mixture score
 //     f = d1 * exp(-d2 / 2 * (x' - mu)^T Sigma^-1 (x' - mu))
@@ -69,6 +71,11 @@ struct NdtConfig {
   /// the circle of a 2 x 2 block of cells around it (src/registration/ndt_target.cpp). Off by
   /// default (OdometryConfig::ndt_stem_cells_across_borders).
   bool stem_cells_across_borders = false;
+  /// > 0: the range noise of the map's points (1-sigma: range_sigma_m + range_sigma_per_m x
+  /// range), which a map built with their beams (LocalMap) takes out of its stem cells' circle
+  /// fits (VoxelStatistics, BeamNoise). 0: the circles are fitted to the noisy points.
+  double range_sigma_m = 0.0;
+  double range_sigma_per_m = 0.0;
   int max_iterations = 35;         ///< per resolution
   double step_epsilon_m = 1e-3;    ///< converged when the translation step is below this...
   double step_epsilon_rad = 1e-4;  ///< ...and the rotation step below this

@@ -13,6 +13,16 @@
 // (the sums of x w, y w and w^2 with w = x^2 + y^2; ndt.hpp, "Stem cells"), as 128-bit integers
 // of the same quanta: exact as well. They are kept beside the other sums, so that statistics
 // without them cost nothing more.
+//
+// Points added with their beams (BeamNoise: the sensor's position and the range noise) also add
+// the range noise's expected share of those moments, so that a circle fit can take it out
+// (errors in variables): a point x = x0 + e u with e ~ N(0, s^2) along its horizontal beam u adds
+// on average s^2 u u^T to x x^T, s^2 (|u|^2 x0 + 2 (u.x0) u) to x w and
+// s^2 (4 (u.x0)^2 + 2 w0 |u|^2) + 3 s^4 |u|^4 to w^2. Unbiased estimates of these from the noisy
+// x are summed (the w^2 term's plug-in is 3 s^4 |u|^4 too large, so that much is subtracted).
+// Without it an arc seen from one side is fitted too small and too near its viewers: 1 cm of
+// range noise on 120 deg of a 10 cm stem puts Taubin's centre 9.5 mm toward them, with it 0.4 mm
+// (bench/BENCHMARK.md, "Session 66").
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -36,6 +46,19 @@ struct CellMoments {
   /// The horizontal section's central moments a circle fit needs, with x, y about the mean and
   /// w = x^2 + y^2 (1/n): E[x w], E[y w] in m^3 and E[w^2] in m^4. Zero without circle_moments.
   double xw = 0.0, yw = 0.0, ww = 0.0;
+  /// The range noise's share of the horizontal covariance (m^2, 1/n) and of xw, yw, ww, from
+  /// the points added with their beams (BeamNoise); zero for the others. The noise-free
+  /// section's moments are the above minus these.
+  Eigen::Matrix2d noise_xx = Eigen::Matrix2d::Zero();
+  double noise_xw = 0.0, noise_yw = 0.0, noise_ww = 0.0;
+};
+
+/// The beams of points added together: the sensor position (in the points' frame) and the
+/// range noise's 1-sigma, sigma_m + sigma_per_m x range.
+struct BeamNoise {
+  Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
+  double sigma_m = 0.0;
+  double sigma_per_m = 0.0;
 };
 
 class VoxelStatistics {
@@ -50,10 +73,15 @@ class VoxelStatistics {
   bool circleMoments() const { return circle_moments_; }
   /// Adds points (non-finite points and points beyond the voxel range are skipped and counted).
   void add(std::span<const Eigen::Vector3d> points);
+  /// Adds points with their beams: with circle_moments, the noise's share of the section's
+  /// moments is summed too (see above); without, the same as add(points).
+  void add(std::span<const Eigen::Vector3d> points, const BeamNoise& beams);
   /// Removes points that were added before (the same coordinates). A point whose cell is empty
   /// throws std::logic_error (the statistics are then partially updated); a point that was never
   /// added but falls into an occupied cell cannot be detected and corrupts that cell's sums.
   void remove(std::span<const Eigen::Vector3d> points);
+  /// Removes points added with these beams.
+  void remove(std::span<const Eigen::Vector3d> points, const BeamNoise& beams);
   void clear() {
     cells_.clear();
     circle_cells_.clear();
@@ -80,9 +108,12 @@ class VoxelStatistics {
   };
   struct CircleSums {
     Int128 xw = 0, yw = 0, ww = 0;  ///< w = x^2 + y^2
+    // The range noise's expected share of xx, xy, yy, xw, yw and ww, rounded to quanta.
+    std::int64_t noise_xx = 0, noise_xy = 0, noise_yy = 0;
+    Int128 noise_xw = 0, noise_yw = 0, noise_ww = 0;
     bool operator==(const CircleSums& o) const = default;
   };
-  void update(const Eigen::Vector3d& p, int sign);
+  void update(const Eigen::Vector3d& p, int sign, const BeamNoise* beams);
   Eigen::Vector3d meanOf(VoxelKey key, const Sums& sums) const;
   CellMoments momentsOf(VoxelKey key, const Sums& sums) const;
   static void circleMoments(const Sums& sums, const CircleSums& circle, CellMoments& m);
