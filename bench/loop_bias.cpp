@@ -9,17 +9,22 @@
 //                                     sides (half the width each)
 //   loop_bias SIM RUN --loops         the run's accepted loops (RUN/loops.csv), each against its
 //                                     candidate's submap as the run built it
+//     [--poses RUN/trajectory_odometry.tum]   the submaps and guesses at these poses instead
+//     [--graph PREFIX]                        and the mapping graph solved with the loops as
+//                                             measured and as true (PREFIX_*.tum for taiga eval)
+//   loop_bias SIM RUN --poses F --relative K  F's relative poses to keyframe K against the truth
 //
+// (bench/BENCHMARK.md, "Session 66": the loop closure does not add to the shrink.)
 // Reported per arrangement: the mean and spread of the translation error, in the keyframe's body
 // frame and along the unit vector from the keyframe to the mean of the submap's keyframe
 // positions ("toward the viewpoints": positive when the keyframe is placed toward them).
 // SIM: a `taiga simulate` output with `ideal` realism (keyframe times on the truth's clock).
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
