@@ -38,7 +38,8 @@ VoxelStatistics::VoxelStatistics(double resolution_m, bool circle_moments)
 }
 
 namespace {
-Int128 roundedToInt128(double value) { return static_cast<Int128>(std::llround(value)); }
+// Not llround: a noise share of a large cell or a loud lidar passes 2^63 quanta^4.
+Int128 roundedToInt128(double value) { return static_cast<Int128>(std::round(value)); }
 }  // namespace
 
 void VoxelStatistics::update(const Eigen::Vector3d& p, int sign, const BeamNoise* beams) {

@@ -70,6 +70,15 @@ TEST(VoxelStatistics, PointsAddedWithTheirBeamsAreRemovedExactly) {
     if (with[i].count >= 2 && with[i].noise_xx.trace() > 0.0) ++with_noise_share;
   }
   EXPECT_GT(with_noise_share, 100);
+
+  // 2 m cells and a 0.5 m noise: shares beyond 2^63 quanta^4, still exact.
+  const BeamNoise loud{{0.0, 0.0, 0.0}, 0.5, 0.01};
+  VoxelStatistics large_a(2.0, true), large(2.0, true);
+  large_a.add(a, loud);
+  large.add(a, loud);
+  large.add(b, loud);
+  large.remove(b, loud);
+  EXPECT_TRUE(large == large_a);
 }
 
 TEST(VoxelStatistics, OrderOfAddingDoesNotMatter) {
