@@ -24,7 +24,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,7 +58,7 @@ struct Options {
 
 struct Case {
   std::size_t current = 0;
-  double fitness_m2 = 0.0;  ///< --loops: the run's
+  double fitness_m2 = 0.0;          ///< --loops: the run's
   std::vector<std::size_t> submap;  ///< keyframe ids; the first is the submap's frame
 };
 
@@ -76,10 +75,9 @@ class Bench {
       : o_(o),
         config_(config),
         store_(mapping::KeyframeStore::open(
-            o.run_dir + "/keyframes",
-            {.registration_voxel_m = config.odometry.voxel_size_m,
-             .registration_voxel_point =
-                 preprocess::voxelRepresentative(config.odometry.voxel_point)})) {
+            o.run_dir + "/keyframes", {.registration_voxel_m = config.odometry.voxel_size_m,
+                                       .registration_voxel_point = preprocess::voxelRepresentative(
+                                           config.odometry.voxel_point)})) {
     const Trajectory truth = io::readTum(o.sim_dir + "/groundtruth.tum");
     for (std::size_t k = 0; k < store_.size(); ++k)
       T_world_body_.push_back(truth.poseAt(store_.info(k).t_s));
@@ -91,8 +89,8 @@ class Bench {
     }
     // Diagnosis: the first keyframes placed by the truth relative to keyframe `true_first`.
     for (std::size_t k = 0; k < static_cast<std::size_t>(o.true_first); ++k)
-      T_map_body_[k] = T_map_body_[o.true_first] * T_world_body_[o.true_first].inverse() *
-                       T_world_body_[k];
+      T_map_body_[k] =
+          T_map_body_[o.true_first] * T_world_body_[o.true_first].inverse() * T_world_body_[k];
   }
   std::size_t size() const { return store_.size(); }
   const lie::SE3& truePose(std::size_t k) const { return T_world_body_[k]; }
@@ -108,11 +106,12 @@ class Bench {
       const Eigen::Vector3d dr = (tru.rotation().inverse() * est.rotation()).Log();
       const Eigen::Vector3d z_est = T_map_body_[k].rotation() * Eigen::Vector3d::UnitZ();
       const Eigen::Vector3d z_tru = T_world_body_[k].rotation() * Eigen::Vector3d::UnitZ();
-      std::printf("%3zu  %6.2f m  t error (%+6.1f %+6.1f %+6.1f) mm  r error (%+6.1f %+6.1f %+6.1f) "
-                  "mdeg  tilt %5.1f mdeg\n",
-                  k, tru.translation().norm(), 1e3 * dt.x(), 1e3 * dt.y(), 1e3 * dt.z(),
-                  1e3 * dr.x() * 180 / M_PI, 1e3 * dr.y() * 180 / M_PI, 1e3 * dr.z() * 180 / M_PI,
-                  1e3 * std::acos(std::clamp(z_est.dot(z_tru), -1.0, 1.0)) * 180 / M_PI);
+      std::printf(
+          "%3zu  %6.2f m  t error (%+6.1f %+6.1f %+6.1f) mm  r error (%+6.1f %+6.1f %+6.1f) "
+          "mdeg  tilt %5.1f mdeg\n",
+          k, tru.translation().norm(), 1e3 * dt.x(), 1e3 * dt.y(), 1e3 * dt.z(),
+          1e3 * dr.x() * 180 / M_PI, 1e3 * dr.y() * 180 / M_PI, 1e3 * dr.z() * 180 / M_PI,
+          1e3 * std::acos(std::clamp(z_est.dot(z_tru), -1.0, 1.0)) * 180 / M_PI);
     }
   }
 
@@ -131,18 +130,16 @@ class Bench {
         T_world_body_[c.submap.front()].inverse() * T_world_body_[c.current];
     const registration::RegistrationResult r = registration::registerClouds(
         store_.registrationCloud(c.current)->positions, submap_in_frame,
-        T_frame_map * T_map_body_[c.current],
-        mapping::loopRegistrationConfig(config_.odometry));
+        T_frame_map * T_map_body_[c.current], mapping::loopRegistrationConfig(config_.odometry));
     Error e;
     e.T_frame_current = r.T_target_source;
     e.converged = r.converged;
     // The estimated position of the current keyframe minus the true one, in the world frame.
-    const Eigen::Vector3d error_in_world = T_world_body_[c.submap.front()].rotation() *
-                                           (r.T_target_source.translation() -
-                                            T_frame_current_true.translation());
+    const Eigen::Vector3d error_in_world =
+        T_world_body_[c.submap.front()].rotation() *
+        (r.T_target_source.translation() - T_frame_current_true.translation());
     e.in_body = T_world_body_[c.current].rotation().inverse() * error_in_world;
-    const Eigen::Vector3d toward =
-        viewpoints_in_world - T_world_body_[c.current].translation();
+    const Eigen::Vector3d toward = viewpoints_in_world - T_world_body_[c.current].translation();
     if (toward.norm() > 1e-6) e.toward_viewpoints_m = error_in_world.dot(toward.normalized());
     return e;
   }
@@ -188,8 +185,8 @@ void report(const char* name, const std::vector<Error>& errors) {
   std::printf(
       "%-8s n %3d (failed %d)  body x %+6.2f (sd %5.2f)  y %+6.2f (%5.2f)  z %+6.2f (%5.2f) mm"
       "  toward viewpoints %+6.2f (sd %5.2f, se %4.2f) mm\n",
-      name, n, failed, 1e3 * mean.x(), 1e3 * sd.x(), 1e3 * mean.y(), 1e3 * sd.y(),
-      1e3 * mean.z(), 1e3 * sd.z(), 1e3 * toward, 1e3 * toward_sd,
+      name, n, failed, 1e3 * mean.x(), 1e3 * sd.x(), 1e3 * mean.y(), 1e3 * sd.y(), 1e3 * mean.z(),
+      1e3 * sd.z(), 1e3 * toward, 1e3 * toward_sd,
       1e3 * toward_sd / std::sqrt(static_cast<double>(n)));
 }
 
@@ -220,15 +217,15 @@ std::vector<Case> runLoops(const Options& o, const SystemConfig& config, std::si
   return cases;
 }
 
-/// The mapping graph of the --poses keyframes with the run's loops, each loop's relative pose
-/// from `loop_of`; its keyframe poses written to `path` (TUM) for `taiga eval`.
+/// The mapping graph of the --poses keyframes with the run's loops, loop i's relative pose
+/// T_frame_current[i]; its keyframe poses written to `path` (TUM) for `taiga eval`.
 void solveGraph(const Bench& bench, const SystemConfig& config, const std::vector<Case>& cases,
-                const std::function<lie::SE3(const Case&)>& loop_of, const std::string& path) {
+                const std::vector<lie::SE3>& T_frame_current, const std::string& path) {
   mapping::PoseGraph graph(config.mapping);
   for (std::size_t k = 0; k < bench.size(); ++k) graph.addKeyframe(bench.pose(k));
-  for (const Case& c : cases)
-    graph.addLoop({c.submap.front(), c.current, loop_of(c),
-                   mapping::loopCovariance(config.odometry, c.fitness_m2)});
+  for (std::size_t i = 0; i < cases.size(); ++i)
+    graph.addLoop({cases[i].submap.front(), cases[i].current, T_frame_current[i],
+                   mapping::loopCovariance(config.odometry, cases[i].fitness_m2)});
   graph.optimize();
   Trajectory keyframes;
   for (std::size_t k = 0; k < bench.size(); ++k) keyframes.append(bench.time(k), graph.pose(k));
@@ -271,22 +268,25 @@ int main(int argc, char** argv) {
   }
 
   if (o.loops) {
+    const std::vector<Case> cases = runLoops(o, config, bench.size());
     std::vector<Error> errors;
-    for (const Case& c : runLoops(o, config, bench.size())) {
+    for (const Case& c : cases) {
       errors.push_back(bench.measure(c));
       const Error& e = errors.back();
       std::printf("loop %zu -> %zu: body (%+.2f, %+.2f, %+.2f) mm, toward %+.2f mm\n", c.current,
-                  c.submap.front(), 1e3 * e.in_body.x(), 1e3 * e.in_body.y(),
-                  1e3 * e.in_body.z(), 1e3 * e.toward_viewpoints_m);
+                  c.submap.front(), 1e3 * e.in_body.x(), 1e3 * e.in_body.y(), 1e3 * e.in_body.z(),
+                  1e3 * e.toward_viewpoints_m);
     }
     report("loops", errors);
     if (!graph_prefix.empty()) {
-      const std::vector<Case> cases = runLoops(o, config, bench.size());
-      solveGraph(bench, config, cases, [&](const Case& c) { return bench.measure(c).T_frame_current; },
-                 graph_prefix + "_measured.tum");
-      solveGraph(bench, config, cases, [&](const Case& c) {
-        return bench.truePose(c.submap.front()).inverse() * bench.truePose(c.current);
-      }, graph_prefix + "_true.tum");
+      std::vector<lie::SE3> measured, truth;
+      for (std::size_t i = 0; i < cases.size(); ++i) {
+        measured.push_back(errors[i].T_frame_current);
+        truth.push_back(bench.truePose(cases[i].submap.front()).inverse() *
+                        bench.truePose(cases[i].current));
+      }
+      solveGraph(bench, config, cases, measured, graph_prefix + "_measured.tum");
+      solveGraph(bench, config, cases, truth, graph_prefix + "_true.tum");
       Trajectory odometry;
       for (std::size_t k = 0; k < bench.size(); ++k) odometry.append(bench.time(k), bench.pose(k));
       io::writeTum(graph_prefix + "_odometry.tum", odometry);

@@ -160,14 +160,18 @@ std::vector<Eigen::Vector3d> mapInWorld(const std::vector<TrueScan>& scans,
   return points;
 }
 
-/// The fine NDT target; with --beam-noise its stem cells take the map points' range noise out
-/// (VoxelStatistics::add with BeamNoise; the body origin stands for the lidar's).
-registration::NdtTarget fineTarget(const Options& o, const std::vector<Eigen::Vector3d>& map,
-                                   const std::vector<Eigen::Vector3d>* sensors,
-                                   const registration::NdtConfig& ndt) {
-  if (o.beam_sigma_m <= 0.0 || sensors == nullptr || !ndt.stem_cells)
-    return registration::NdtTarget::fromPoints(map, o.resolution_m, ndt);
-  registration::VoxelStatistics statistics(o.resolution_m, true);
+/// The map's statistics at the fine resolution; with --beam-noise and the points' sensors, the
+/// stem cells' noise shares too (VoxelStatistics::add with BeamNoise; the body origin stands for
+/// the lidar's).
+registration::VoxelStatistics fineStatistics(const Options& o,
+                                             const std::vector<Eigen::Vector3d>& map,
+                                             const std::vector<Eigen::Vector3d>* sensors,
+                                             bool circle_moments) {
+  registration::VoxelStatistics statistics(o.resolution_m, circle_moments);
+  if (sensors == nullptr) {
+    statistics.add(map);
+    return statistics;
+  }
   for (std::size_t begin = 0; begin < map.size();) {
     std::size_t end = begin;
     while (end < map.size() && (*sensors)[end] == (*sensors)[begin]) ++end;
@@ -175,7 +179,13 @@ registration::NdtTarget fineTarget(const Options& o, const std::vector<Eigen::Ve
                    {(*sensors)[begin], o.beam_sigma_m, o.beam_sigma_per_m});
     begin = end;
   }
-  return registration::NdtTarget(statistics, ndt);
+  return statistics;
+}
+
+registration::NdtTarget fineTarget(const Options& o, const std::vector<Eigen::Vector3d>& map,
+                                   const std::vector<Eigen::Vector3d>* sensors,
+                                   const registration::NdtConfig& ndt) {
+  return registration::NdtTarget(fineStatistics(o, map, sensors, ndt.stem_cells), ndt);
 }
 
 registration::RegistrationResult align(const Options& o, std::span<const Eigen::Vector3d> source,
@@ -321,13 +331,12 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
     const Eigen::Vector3d last = scans[keyframes.back()].T_world_body.translation();
     if ((scans[i].T_world_body.translation() - last).norm() >= 1.0) keyframes.push_back(i);
   }
-  const char* kClasses[] = {
-      "ground (|n_z| > 0.8)", "upright (|n_z| < 0.3)",  "other",        "range < 5 m",
-      "range 5-10 m",         "range 10-20 m",          "range > 20 m", "in stem cells",
-      "upright, other, stem", "upright, other, no stem",
-      // upright, other, stem by the stem gate their cell fails
-      "  (passes)", "  few points", "  leaning or flat", "  no circle", "  radius", "  residual",
-      "  short arc"};
+  const char* kClasses[] = {"ground (|n_z| > 0.8)", "upright (|n_z| < 0.3)", "other", "range < 5 m",
+                            "range 5-10 m", "range 10-20 m", "range > 20 m", "in stem cells",
+                            "upright, other, stem", "upright, other, no stem",
+                            // upright, other, stem by the stem gate their cell fails
+                            "  (passes)", "  few points", "  leaning or flat", "  no circle",
+                            "  radius", "  residual", "  short arc"};
   constexpr int kNumClasses = 17;
   std::vector<double> along_m[kNumClasses], up_m[kNumClasses], total_along_m, total_up_m;
   registration::NdtConfig ndt;
@@ -350,10 +359,11 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
     std::vector<Eigen::Vector3d> sensors;
     const std::vector<Eigen::Vector3d> map_points = mapInWorld(
         scans, chosen, T_world_keyframe, scan.T_world_body.translation(), 180.0, &sensors);
-    const auto target = fineTarget(o, map_points, &sensors, ndt);
-    // Which stem gate the cells of near-stem points outside stem cells fail.
-    registration::VoxelStatistics statistics(o.resolution_m, true);
-    statistics.add(map_points);
+    // The statistics with circle moments whatever --stem-cells: which stem gate the cells of
+    // near-stem points outside stem cells fail.
+    const registration::VoxelStatistics statistics =
+        fineStatistics(o, map_points, &sensors, true);
+    const registration::NdtTarget target(statistics, ndt);
     std::unordered_map<registration::VoxelKey, registration::CellMoments> moments_of;
     for (const registration::CellMoments& m : statistics.moments()) moments_of[m.key] = m;
     std::vector<Eigen::Vector3d> by_class[kNumClasses];
@@ -372,7 +382,8 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
         by_class[near_stem ? 8 : 9].push_back(p);
         const auto found = moments_of.find(registration::voxelOf(q, 1.0 / o.resolution_m));
         if (near_stem && found != moments_of.end()) {
-          const int gate = static_cast<int>(registration::stemGateOf(found->second, o.resolution_m));
+          const int gate =
+              static_cast<int>(registration::stemGateOf(found->second, o.resolution_m));
           ++gate_counts[gate];
           by_class[10 + gate].push_back(p);
         }
@@ -409,8 +420,13 @@ void measureForces(const Options& o, const std::vector<TrueScan>& scans) {
                 1e3 * mean(up_m[c]));
   std::printf("  %zu source points in cells, %zu in upright ones, %zu in stem cells\n",
               num_points, num_upright, num_stem);
-  const char* kGates[] = {"passes (a neighbour's cell)", "few points", "leaning or flat",
-                          "no circle", "radius", "residual", "short arc"};
+  const char* kGates[] = {"passes (a neighbour's cell)",
+                          "few points",
+                          "leaning or flat",
+                          "no circle",
+                          "radius",
+                          "residual",
+                          "short arc"};
   std::printf("  upright, other, stem: the gate their cell fails:");
   for (int g = 0; g < 7; ++g) std::printf(" %s %zu;", kGates[g], gate_counts[g]);
   std::printf("\n");
@@ -462,11 +478,12 @@ void runOdometry(const Options& o, const std::vector<TrueScan>& scans) {
     estimate_poses.push_back({0.1 * static_cast<double>(i), T_world_body_estimate[i]});
     true_poses.push_back({0.1 * static_cast<double>(i), scans[i].T_world_body});
   }
-  std::printf("%s odometry, %.2f m cells (coarse %.2f m), %d keyframes in the map: %zu scans, "
-              "%zu keyframes, Sim(3) scale %.5f, path length ratio %.5f\n",
-              o.method.c_str(), o.resolution_m, o.coarse_resolution_m, o.num_keyframes,
-              scans.size(), keyframes.size(), std::cbrt(sim3.topLeftCorner<3, 3>().determinant()),
-              eval::computeDrift(estimate_poses, true_poses).path_length_ratio);
+  std::printf(
+      "%s odometry, %.2f m cells (coarse %.2f m), %d keyframes in the map: %zu scans, "
+      "%zu keyframes, Sim(3) scale %.5f, path length ratio %.5f\n",
+      o.method.c_str(), o.resolution_m, o.coarse_resolution_m, o.num_keyframes, scans.size(),
+      keyframes.size(), std::cbrt(sim3.topLeftCorner<3, 3>().determinant()),
+      eval::computeDrift(estimate_poses, true_poses).path_length_ratio);
 }
 
 /// groundtruth.tum against the regenerated motion, and the deskewed points (true poses) against

@@ -26,7 +26,8 @@ std::pair<imu::InitialState, double> ImuPrior::initialAttitude(const io::Scan& f
                                                   ? recentReadings(first.t_start_s)
                                                   : imu_.between(imu_.firstTime(), first.t_start_s);
   const bool before_suffices =
-      before_first.size() >= imu::kMinInitializationReadings && before_first.back().t_s <= first.t_start_s &&
+      before_first.size() >= imu::kMinInitializationReadings &&
+      before_first.back().t_s <= first.t_start_s &&
       (restart_T_odom_body_ || before_first.back().orientation.has_value());
   const imu::InitialState init = imu::initializeFromImu(before_suffices ? before_first : imu_.all(),
                                                         {.gravity_mps2 = config_.imu.gravity_mps2});

@@ -77,21 +77,12 @@ void LocalMap::account(const std::vector<const Keyframe*>& added,
   for (const Keyframe* keyframe : removed) removed_in_odom.push_back(inOdom(*keyframe));
   // Removal subtracts exactly what adding added: the same points through the same pose. The
   // statistics are independent and each is updated by one thread, in the same order as before.
-  // Only statistics with circle moments (the stem cells') take the beams.
-  const bool beams = ndt_cells_.range_sigma_m > 0.0 || ndt_cells_.range_sigma_per_m > 0.0;
+  // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
   std::vector<registration::VoxelStatistics*> all{&point_statistics_};
   for (registration::VoxelStatistics& statistics : ndt_statistics_) all.push_back(&statistics);
   tbb::parallel_for(std::size_t{0}, all.size(), [&](std::size_t i) {
-    registration::VoxelStatistics& statistics = *all[i];
-    const bool with_beams = beams && statistics.circleMoments();
-    for (const InOdom& keyframe : added_in_odom) {
-      if (with_beams) statistics.add(keyframe.points, keyframe.beams);
-      else statistics.add(keyframe.points);
-    }
-    for (const InOdom& keyframe : removed_in_odom) {
-      if (with_beams) statistics.remove(keyframe.points, keyframe.beams);
-      else statistics.remove(keyframe.points);
-    }
+    for (const InOdom& keyframe : added_in_odom) all[i]->add(keyframe.points, keyframe.beams);
+    for (const InOdom& keyframe : removed_in_odom) all[i]->remove(keyframe.points, keyframe.beams);
   });
 }
 

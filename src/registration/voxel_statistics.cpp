@@ -42,6 +42,29 @@ namespace {
 Int128 roundedToInt128(double value) { return static_cast<Int128>(std::round(value)); }
 }  // namespace
 
+void VoxelStatistics::addNoiseShare(const Eigen::Vector3d& p, const std::int64_t q[3],
+                                    const BeamNoise& beams, int sign, CircleSums& circle) {
+  // The noise's expected share (voxel_statistics.hpp), in quanta, from this point's x (q about
+  // the cell centre) and beam; rounded alike when it is removed, so the sums stay exact.
+  if (!(beams.sigma_m > 0.0 || beams.sigma_per_m > 0.0)) return;
+  const Eigen::Vector3d beam = p - beams.sensor;
+  const double range_m = beam.norm();
+  const double sigma_m = beams.sigma_m + beams.sigma_per_m * range_m;
+  if (!(range_m > 0.0 && sigma_m > 0.0)) return;
+  const double sigma_q = sigma_m / kQuantum_m;
+  const double s2 = sigma_q * sigma_q;
+  const double ux = beam.x() / range_m, uy = beam.y() / range_m, uu = ux * ux + uy * uy;
+  const double x = static_cast<double>(q[0]), y = static_cast<double>(q[1]);
+  const double ud = ux * x + uy * y;
+  circle.noise_xx += sign * std::llround(s2 * ux * ux);
+  circle.noise_xy += sign * std::llround(s2 * ux * uy);
+  circle.noise_yy += sign * std::llround(s2 * uy * uy);
+  circle.noise_xw += sign * roundedToInt128(s2 * (uu * x + 2.0 * ud * ux));
+  circle.noise_yw += sign * roundedToInt128(s2 * (uu * y + 2.0 * ud * uy));
+  circle.noise_ww += sign * roundedToInt128(s2 * (4.0 * ud * ud + 2.0 * (x * x + y * y) * uu) -
+                                            3.0 * s2 * s2 * uu * uu);
+}
+
 void VoxelStatistics::update(const Eigen::Vector3d& p, int sign, const BeamNoise* beams) {
   const VoxelKey key = voxelOf(p, inverse_resolution_);
   if (key == kInvalidVoxel) {
@@ -75,26 +98,7 @@ void VoxelStatistics::update(const Eigen::Vector3d& p, int sign, const BeamNoise
     circle.xw += sign * (q[0] * w);
     circle.yw += sign * (q[1] * w);
     circle.ww += sign * (w * w);
-    if (beams != nullptr) {
-      // The noise's expected share (voxel_statistics.hpp), in quanta, from this point's x and
-      // beam; rounded alike when it is removed, so the sums stay exact.
-      const Eigen::Vector3d beam = p - beams->sensor;
-      const double range_m = beam.norm();
-      if (range_m > 0.0) {
-        const double sigma_q = (beams->sigma_m + beams->sigma_per_m * range_m) / kQuantum_m;
-        const double s2 = sigma_q * sigma_q;
-        const double ux = beam.x() / range_m, uy = beam.y() / range_m, uu = ux * ux + uy * uy;
-        const double x = static_cast<double>(q[0]), y = static_cast<double>(q[1]);
-        const double ud = ux * x + uy * y;
-        circle.noise_xx += sign * std::llround(s2 * ux * ux);
-        circle.noise_xy += sign * std::llround(s2 * ux * uy);
-        circle.noise_yy += sign * std::llround(s2 * uy * uy);
-        circle.noise_xw += sign * roundedToInt128(s2 * (uu * x + 2.0 * ud * ux));
-        circle.noise_yw += sign * roundedToInt128(s2 * (uu * y + 2.0 * ud * uy));
-        circle.noise_ww += sign * roundedToInt128(s2 * (4.0 * ud * ud + 2.0 * (x * x + y * y) * uu) -
-                                                  3.0 * s2 * s2 * uu * uu);
-      }
-    }
+    if (beams != nullptr) addNoiseShare(p, q, *beams, sign, circle);
     if (sums.count == 0) circle_cells_.erase(key);
   }
   if (sums.count == 0) cells_.erase(it);

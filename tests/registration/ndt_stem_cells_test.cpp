@@ -97,8 +97,7 @@ TEST(NdtStemCells, RangeNoiseAlongTheBeamsIsTakenOutOfTheCircle) {
   const Eigen::Vector3d viewer(0.0, 0.25, 0.0);
   const double radius_m = 0.1, sigma_m = 0.01;
   const BeamNoise beams{viewer, sigma_m, 0.0};
-  double toward_without_m = 0.0, toward_with_m = 0.0, radius_without_m = 0.0,
-         radius_with_m = 0.0;
+  double toward_without_m = 0.0, toward_with_m = 0.0, radius_without_m = 0.0, radius_with_m = 0.0;
   constexpr int kRuns = 40;
   for (int run = 0; run < kRuns; ++run) {
     std::mt19937 rng(100 + run);
@@ -113,14 +112,17 @@ TEST(NdtStemCells, RangeNoiseAlongTheBeamsIsTakenOutOfTheCircle) {
     }
     for (const bool with_beams : {false, true}) {
       VoxelStatistics statistics(0.5, true);
-      if (with_beams) statistics.add(points, beams);
-      else statistics.add(points);
+      if (with_beams)
+        statistics.add(points, beams);
+      else
+        statistics.add(points);
       NdtCell cell;
       ASSERT_TRUE(fitStemSection(statistics.moments().at(0), 0.5, 1e-6, cell))
           << run << " " << with_beams << " gate "
           << static_cast<int>(stemGateOf(statistics.moments().at(0), 0.5));
       // Toward the viewer is -x.
-      (with_beams ? toward_with_m : toward_without_m) += (centre.x() - cell.stem_centre.x()) / kRuns;
+      (with_beams ? toward_with_m : toward_without_m) +=
+          (centre.x() - cell.stem_centre.x()) / kRuns;
       (with_beams ? radius_with_m : radius_without_m) += (cell.stem_radius_m - radius_m) / kRuns;
     }
   }

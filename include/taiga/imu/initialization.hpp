@@ -48,7 +48,8 @@ struct InitialState {
 inline constexpr std::size_t kMinInitializationReadings = 10;
 
 /// Uses the readings within config.window_s of the first one. Throws InputError when there are
-/// fewer than kMinInitializationReadings in the window or the specific force is far from gravity (a wrong unit).
+/// fewer than kMinInitializationReadings in the window or the specific force is far from gravity (a
+/// wrong unit).
 InitialState initializeFromImu(std::span<const ImuSample> samples,
                                const InitializationConfig& config = {});
 

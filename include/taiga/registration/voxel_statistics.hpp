@@ -73,8 +73,8 @@ class VoxelStatistics {
   bool circleMoments() const { return circle_moments_; }
   /// Adds points (non-finite points and points beyond the voxel range are skipped and counted).
   void add(std::span<const Eigen::Vector3d> points);
-  /// Adds points with their beams: with circle_moments, the noise's share of the section's
-  /// moments is summed too (see above); without, the same as add(points).
+  /// Adds points with their beams: with circle_moments and a noise above zero, the noise's share
+  /// of the section's moments is summed too (see above); otherwise the same as add(points).
   void add(std::span<const Eigen::Vector3d> points, const BeamNoise& beams);
   /// Removes points that were added before (the same coordinates). A point whose cell is empty
   /// throws std::logic_error (the statistics are then partially updated); a point that was never
@@ -114,6 +114,10 @@ class VoxelStatistics {
     bool operator==(const CircleSums& o) const = default;
   };
   void update(const Eigen::Vector3d& p, int sign, const BeamNoise* beams);
+  /// Adds (sign +1) or removes the range noise's share of point p (q: p about its cell centre, in
+  /// quanta) to a cell's circle sums; nothing for a zero noise.
+  static void addNoiseShare(const Eigen::Vector3d& p, const std::int64_t q[3],
+                            const BeamNoise& beams, int sign, CircleSums& circle);
   Eigen::Vector3d meanOf(VoxelKey key, const Sums& sums) const;
   CellMoments momentsOf(VoxelKey key, const Sums& sums) const;
   static void circleMoments(const Sums& sums, const CircleSums& circle, CellMoments& m);
