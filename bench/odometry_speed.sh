@@ -34,15 +34,16 @@ for label in ("reference", "new"):
     for run in range(1, runs + 1):
         s = json.load(open(f"{out}/{label}_{run}/summary.json"))
         t = s["time_per_scan_ms"]
-        rows[label].append((s["realtime_factor"], t["p50"], t["p95"], t["mean"], s["wall_time_s"]))
+        rows[label].append((s["realtime_factor"], t["p50"], t["p95"], t["mean"], s["wall_time_s"],
+                            t["p99"], t["max"]))
         print(f"{label:9s} run {run}: real-time factor {s['realtime_factor']:.2f}, per scan "
-              f"median {t['p50']:.1f} ms, p95 {t['p95']:.1f} ms, mean {t['mean']:.1f} ms, "
-              f"wall {s['wall_time_s']:.1f} s")
+              f"median {t['p50']:.1f} ms, p95 {t['p95']:.1f} ms, p99 {t['p99']:.1f} ms, "
+              f"max {t['max']:.1f} ms, mean {t['mean']:.1f} ms, wall {s['wall_time_s']:.1f} s")
 med = {label: [statistics.median(column) for column in zip(*rows[label])] for label in rows}
 for label in rows:
-    rtf, p50, p95, mean, wall = med[label]
+    rtf, p50, p95, mean, wall, p99, worst = med[label]
     print(f"{label:9s} median: real-time factor {rtf:.2f}, per scan median {p50:.1f} ms, "
-          f"p95 {p95:.1f} ms, mean {mean:.1f} ms")
+          f"p95 {p95:.1f} ms, p99 {p99:.1f} ms, max {worst:.1f} ms, mean {mean:.1f} ms")
 print(f"ratio new/reference: real-time factor {med['new'][0] / med['reference'][0]:.2f}x, "
       f"per-scan median time {med['new'][1] / med['reference'][1]:.2f}, "
       f"wall time {med['new'][4] / med['reference'][4]:.2f}")

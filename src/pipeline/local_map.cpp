@@ -35,32 +35,17 @@ LocalMap::~LocalMap() {
   if (pending_.valid()) pending_.wait();
 }
 
-// The NDT targets and the kd-tree (with the GICP cloud) are independent: built side by side. Each
-// is built by one thread as before, so the result is the same on any number of threads.
-LocalMap::SearchStructures LocalMap::build() const {
-  SearchStructures built;
-  std::vector<Eigen::Vector3d> points;
-  auto build_ndt = [&] {
-    for (const registration::VoxelStatistics& statistics : ndt_statistics_)
-      built.ndt_targets.push_back(std::make_unique<registration::NdtTarget>(
-          statistics, ndt_cells_.cellsAt(statistics.resolution_m())));
-  };
-  auto build_points = [&] {
-    points = point_statistics_.means();
-    built.kd_tree = std::make_unique<registration::KdTree>(points);
-    if (target_ == Target::kGicp)
-      built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
-  };
-  tbb::parallel_invoke(build_ndt, build_points);
-  return built;
-}
-
 void LocalMap::finishPendingBuild() {
   if (pending_.valid()) in_use_ = pending_.get();
 }
 
-void LocalMap::account(const std::vector<const Keyframe*>& added,
-                       const std::vector<const Keyframe*>& removed) {
+// The NDT branch (its statistics, then its targets) and the points branch (the point statistics,
+// then the means, the kd-tree and the GICP cloud) are independent: run side by side. Each
+// statistic is updated and each structure built by one thread, in the same order as before, so
+// the result is the same on any number of threads. Removal subtracts exactly what adding added:
+// the same points through the same pose.
+LocalMap::SearchStructures LocalMap::update(const std::vector<const Keyframe*>& added,
+                                            const std::vector<const Keyframe*>& removed) {
   struct InOdom {
     std::vector<Eigen::Vector3d> points;
     registration::BeamNoise beams;  ///< the keyframe's lidar and the range noise
@@ -75,15 +60,32 @@ void LocalMap::account(const std::vector<const Keyframe*>& added,
   std::vector<InOdom> added_in_odom, removed_in_odom;
   for (const Keyframe* keyframe : added) added_in_odom.push_back(inOdom(*keyframe));
   for (const Keyframe* keyframe : removed) removed_in_odom.push_back(inOdom(*keyframe));
-  // Removal subtracts exactly what adding added: the same points through the same pose. The
-  // statistics are independent and each is updated by one thread, in the same order as before.
   // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
-  std::vector<registration::VoxelStatistics*> all{&point_statistics_};
-  for (registration::VoxelStatistics& statistics : ndt_statistics_) all.push_back(&statistics);
-  tbb::parallel_for(std::size_t{0}, all.size(), [&](std::size_t i) {
-    for (const InOdom& keyframe : added_in_odom) all[i]->add(keyframe.points, keyframe.beams);
-    for (const InOdom& keyframe : removed_in_odom) all[i]->remove(keyframe.points, keyframe.beams);
-  });
+  auto account = [&](registration::VoxelStatistics& statistics) {
+    for (const InOdom& keyframe : added_in_odom) statistics.add(keyframe.points, keyframe.beams);
+    for (const InOdom& keyframe : removed_in_odom)
+      statistics.remove(keyframe.points, keyframe.beams);
+  };
+
+  SearchStructures built;
+  built.ndt_targets.resize(ndt_statistics_.size());
+  auto ndt_branch = [&] {
+    tbb::parallel_for(std::size_t{0}, ndt_statistics_.size(), [&](std::size_t i) {
+      registration::VoxelStatistics& statistics = ndt_statistics_[i];
+      account(statistics);
+      built.ndt_targets[i] = std::make_unique<registration::NdtTarget>(
+          statistics, ndt_cells_.cellsAt(statistics.resolution_m()));
+    });
+  };
+  auto points_branch = [&] {
+    account(point_statistics_);
+    const std::vector<Eigen::Vector3d> points = point_statistics_.means();
+    built.kd_tree = std::make_unique<registration::KdTree>(points);
+    if (target_ == Target::kGicp)
+      built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
+  };
+  tbb::parallel_invoke(ndt_branch, points_branch);
+  return built;
 }
 
 void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
@@ -102,8 +104,7 @@ void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
                         [this, &added = keyframes_.back(), dropped = std::move(dropped)] {
                           std::vector<const Keyframe*> removed;
                           for (const Keyframe& keyframe : dropped) removed.push_back(&keyframe);
-                          account({&added}, removed);
-                          return build();
+                          return update({&added}, removed);
                         });
   registrations_since_keyframe_ = 0;
 }
@@ -119,9 +120,9 @@ void LocalMap::repose(
     keyframe.T_odom_keyframe = T_odom_keyframe_at(keyframe.id, keyframe.T_odom_keyframe);
     all.push_back(&keyframe);
   }
-  account(all, {});
   in_use_ = {};  // so that beginRegistration() waits for the structures in the new frame
-  if (!keyframes_.empty()) pending_ = std::async(std::launch::async, [this] { return build(); });
+  if (!keyframes_.empty())
+    pending_ = std::async(std::launch::async, [this, all] { return update(all, {}); });
 }
 
 void LocalMap::beginRegistration() {

@@ -145,7 +145,7 @@ PointCloud voxelFilter(const PointCloud& cloud, double voxel_size_m,
   std::vector<std::pair<std::uint64_t, const Partition::Cell*>> order;
   for (const Partition& partition : partitions)
     for (const Partition::Cell& cell : partition.cells) order.emplace_back(cell.key, &cell);
-  radixSortByKey(order);
+  radixSortByVoxelKey(order);
 
   std::vector<Eigen::Vector3d> centroids;
   std::vector<std::size_t> representatives;

@@ -203,7 +203,7 @@ std::vector<CellMoments> VoxelStatistics::moments(std::size_t min_points) const 
   for (const auto& [key, sums] : cells_) {
     if (static_cast<std::size_t>(sums.count) >= min_points) cells.emplace_back(key, &sums);
   }
-  radixSortByKey(cells);
+  radixSortByVoxelKey(cells);
   std::vector<CellMoments> out;
   out.reserve(cells.size());
   for (const auto& [key, sums] : cells) out.push_back(momentsOf(key, *sums));
@@ -214,7 +214,7 @@ std::vector<Eigen::Vector3d> VoxelStatistics::means() const {
   std::vector<std::pair<VoxelKey, Eigen::Vector3d>> cells;
   cells.reserve(cells_.size());
   for (const auto& [key, sums] : cells_) cells.emplace_back(key, meanOf(key, sums));
-  radixSortByKey(cells);
+  radixSortByVoxelKey(cells);
   std::vector<Eigen::Vector3d> out;
   out.reserve(cells.size());
   for (const auto& cell : cells) out.push_back(cell.second);

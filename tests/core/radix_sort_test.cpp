@@ -12,11 +12,15 @@ namespace taiga {
 namespace {
 
 template <class Key>
-void expectSameOrderAsAStableSort(std::vector<std::pair<Key, int>> items) {
+void expectSameOrderAsAStableSort(std::vector<std::pair<Key, int>> items, bool voxel_keys = false) {
   std::vector<std::pair<Key, int>> expected = items;
   std::stable_sort(expected.begin(), expected.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  radixSortByKey(items);
+  if (voxel_keys) {
+    radixSortByVoxelKey(items);
+  } else {
+    radixSortByKey(items);
+  }
   EXPECT_EQ(items, expected);
 }
 
@@ -45,6 +49,25 @@ TEST(RadixSort, SortsPackedVoxelKeysWhoseHighBytesAgree) {
     items.emplace_back((x << 42) | (y << 21) | z, i);
   }
   expectSameOrderAsAStableSort(items);
+}
+
+TEST(RadixSort, SortsVoxelKeysAroundTheOriginAsAnySortDoes) {
+  // Cells on either side of the origin in every axis (each field either side of 2^20), as signed
+  // and as unsigned keys, with some keys repeated (kept in input order).
+  std::mt19937_64 rng(4);
+  std::vector<std::pair<std::int64_t, int>> signed_items;
+  std::vector<std::pair<std::uint64_t, int>> unsigned_items;
+  for (int i = 0; i < 4000; ++i) {
+    const std::uint64_t x = (1u << 20) + rng() % 600 - 300, y = (1u << 20) + rng() % 600 - 300,
+                        z = (1u << 20) + rng() % 100 - 50;
+    const std::uint64_t key = (x << 42) | (y << 21) | z;
+    signed_items.emplace_back(static_cast<std::int64_t>(key), i);
+    unsigned_items.emplace_back(key, i);
+  }
+  expectSameOrderAsAStableSort(signed_items, true);
+  expectSameOrderAsAStableSort(unsigned_items, true);
+  expectSameOrderAsAStableSort(std::vector<std::pair<std::uint64_t, int>>{{7, 0}, {7, 1}, {7, 2}},
+                               true);
 }
 
 TEST(RadixSort, LeavesEmptyAndSingleInputsAlone) {

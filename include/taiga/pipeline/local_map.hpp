@@ -95,7 +95,6 @@ class LocalMap {
     mutable double occupancy_voxel_m = 0.0;
     mutable std::unique_ptr<registration::NdtTarget> coarse_ndt_target;  ///< built on demand
   };
-  SearchStructures build() const;
   /// Waits for a background build and makes it the one in use.
   void finishPendingBuild();
 
@@ -109,9 +108,10 @@ class LocalMap {
     lie::SE3 T_odom_keyframe;
     std::vector<Eigen::Vector3d> points_in_keyframe;
   };
-  /// Adds keyframes' points, in the odom frame, to the statistics, then removes others'.
-  void account(const std::vector<const Keyframe*>& added,
-               const std::vector<const Keyframe*>& removed);
+  /// Adds keyframes' points, in the odom frame, to the statistics, removes others', and builds
+  /// the search structures from them.
+  SearchStructures update(const std::vector<const Keyframe*>& added,
+                          const std::vector<const Keyframe*>& removed);
 
   std::deque<Keyframe> keyframes_;
   std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
