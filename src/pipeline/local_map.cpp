@@ -1,7 +1,6 @@
 #include "taiga/pipeline/local_map.hpp"
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #include <stdexcept>
 
@@ -23,7 +22,8 @@ void LocalMap::setNdtResolutions(const std::vector<double>& ndt_resolutions_m) {
   if (ndt_resolutions_m.empty()) throw std::invalid_argument("LocalMap: no NDT resolution");
   if (!keyframes_.empty()) throw std::logic_error("LocalMap: NDT resolutions set on a full map");
   finishPendingBuild();
-  in_use_ = {};
+  ndt_in_use_ = {};
+  points_in_use_ = {};
   ndt_statistics_.clear();
   // Only the NDT target needs cells; GICP uses the points.
   if (target_ == Target::kNdt)
@@ -32,80 +32,94 @@ void LocalMap::setNdtResolutions(const std::vector<double>& ndt_resolutions_m) {
 }
 
 LocalMap::~LocalMap() {
-  if (pending_.valid()) pending_.wait();
+  if (pending_ndt_.valid()) pending_ndt_.wait();
+  if (pending_points_.valid()) pending_points_.wait();
 }
 
 void LocalMap::finishPendingBuild() {
-  if (pending_.valid()) in_use_ = pending_.get();
+  if (pending_ndt_.valid()) ndt_in_use_ = pending_ndt_.get();
+  if (pending_points_.valid()) points_in_use_ = pending_points_.get();
+  points_due_ = false;
+  dropped_.clear();
 }
 
-// The NDT branch (its statistics, then its targets) and the points branch (the point statistics,
-// then the means, the kd-tree and the GICP cloud) are independent: run side by side. Each
-// statistic is updated and each structure built by one thread, in the same order as before, so
-// the result is the same on any number of threads. Removal subtracts exactly what adding added:
-// the same points through the same pose.
-LocalMap::SearchStructures LocalMap::update(const std::vector<const Keyframe*>& added,
-                                            const std::vector<const Keyframe*>& removed) {
-  struct InOdom {
-    std::vector<Eigen::Vector3d> points;
-    registration::BeamNoise beams;  ///< the keyframe's lidar and the range noise
-  };
-  auto inOdom = [&](const Keyframe& keyframe) {
-    InOdom out{keyframe.points_in_keyframe,
-               {keyframe.T_odom_keyframe * p_keyframe_lidar_, ndt_cells_.range_sigma_m,
-                ndt_cells_.range_sigma_per_m}};
-    for (Eigen::Vector3d& p : out.points) p = keyframe.T_odom_keyframe * p;
-    return out;
-  };
-  std::vector<InOdom> added_in_odom, removed_in_odom;
-  for (const Keyframe* keyframe : added) added_in_odom.push_back(inOdom(*keyframe));
-  for (const Keyframe* keyframe : removed) removed_in_odom.push_back(inOdom(*keyframe));
-  // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
-  auto account = [&](registration::VoxelStatistics& statistics) {
-    for (const InOdom& keyframe : added_in_odom) statistics.add(keyframe.points, keyframe.beams);
-    for (const InOdom& keyframe : removed_in_odom)
-      statistics.remove(keyframe.points, keyframe.beams);
-  };
+const LocalMap::PointStructures& LocalMap::pointStructures() const {
+  if (points_due_) {
+    if (pending_points_.valid()) points_in_use_ = pending_points_.get();
+    points_due_ = false;
+  }
+  return points_in_use_;
+}
 
-  SearchStructures built;
-  built.ndt_targets.resize(ndt_statistics_.size());
-  auto ndt_branch = [&] {
+namespace {
+/// A keyframe's local-map points in the odom frame, with their beams for the range noise.
+struct InOdom {
+  std::vector<Eigen::Vector3d> points;
+  registration::BeamNoise beams;
+};
+}  // namespace
+
+// The NDT targets and the points' structures are built by two tasks side by side, each from its
+// own statistics, so that the registration can start on the targets while the kd-tree is still
+// being built. Each statistic is updated and each structure built by one thread, in the same order
+// as before, so the result is the same on any number of threads. Removal subtracts exactly what
+// adding added: the same points through the same pose.
+void LocalMap::startBuild(std::vector<const Keyframe*> added,
+                          std::vector<const Keyframe*> removed) {
+  auto account = [this, added, removed](registration::VoxelStatistics& statistics) {
+    auto inOdom = [&](const Keyframe& keyframe) {
+      InOdom out{keyframe.points_in_keyframe,
+                 {keyframe.T_odom_keyframe * p_keyframe_lidar_, ndt_cells_.range_sigma_m,
+                  ndt_cells_.range_sigma_per_m}};
+      for (Eigen::Vector3d& p : out.points) p = keyframe.T_odom_keyframe * p;
+      return out;
+    };
+    // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
+    for (const Keyframe* keyframe : added) {
+      const InOdom in_odom = inOdom(*keyframe);
+      statistics.add(in_odom.points, in_odom.beams);
+    }
+    for (const Keyframe* keyframe : removed) {
+      const InOdom in_odom = inOdom(*keyframe);
+      statistics.remove(in_odom.points, in_odom.beams);
+    }
+  };
+  pending_ndt_ = std::async(std::launch::async, [this, account] {
+    NdtStructures built;
+    built.targets.resize(ndt_statistics_.size());
     tbb::parallel_for(std::size_t{0}, ndt_statistics_.size(), [&](std::size_t i) {
       registration::VoxelStatistics& statistics = ndt_statistics_[i];
       account(statistics);
-      built.ndt_targets[i] = std::make_unique<registration::NdtTarget>(
+      built.targets[i] = std::make_unique<registration::NdtTarget>(
           statistics, ndt_cells_.cellsAt(statistics.resolution_m()));
     });
-  };
-  auto points_branch = [&] {
+    return built;
+  });
+  pending_points_ = std::async(std::launch::async, [this, account] {
     account(point_statistics_);
+    PointStructures built;
     const std::vector<Eigen::Vector3d> points = point_statistics_.means();
     built.kd_tree = std::make_unique<registration::KdTree>(points);
     if (target_ == Target::kGicp)
       built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
-  };
-  tbb::parallel_invoke(ndt_branch, points_branch);
-  return built;
+    return built;
+  });
 }
 
 void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
                            std::vector<Eigen::Vector3d> points_in_keyframe) {
   finishPendingBuild();  // it reads the statistics and keyframes that change now
   keyframes_.push_back({id, T_odom_keyframe, std::move(points_in_keyframe)});
-  std::vector<Keyframe> dropped;
   while (static_cast<int>(keyframes_.size()) > max_keyframes_) {
-    dropped.push_back(std::move(keyframes_.front()));
+    dropped_.push_back(std::move(keyframes_.front()));
     keyframes_.pop_front();
   }
   // The statistics are brought up to date in the background, before the build: on the main
   // thread they made the keyframe's scan twice as slow as any other (bench/BENCHMARK.md,
   // "Session 37"). Nothing else reads them until finishPendingBuild().
-  pending_ = std::async(std::launch::async,
-                        [this, &added = keyframes_.back(), dropped = std::move(dropped)] {
-                          std::vector<const Keyframe*> removed;
-                          for (const Keyframe& keyframe : dropped) removed.push_back(&keyframe);
-                          return update({&added}, removed);
-                        });
+  std::vector<const Keyframe*> removed;
+  for (const Keyframe& keyframe : dropped_) removed.push_back(&keyframe);
+  startBuild({&keyframes_.back()}, std::move(removed));
   registrations_since_keyframe_ = 0;
 }
 
@@ -120,16 +134,21 @@ void LocalMap::repose(
     keyframe.T_odom_keyframe = T_odom_keyframe_at(keyframe.id, keyframe.T_odom_keyframe);
     all.push_back(&keyframe);
   }
-  in_use_ = {};  // so that beginRegistration() waits for the structures in the new frame
-  if (!keyframes_.empty())
-    pending_ = std::async(std::launch::async, [this, all] { return update(all, {}); });
+  // No structures in use: beginRegistration() waits for those in the new frame.
+  ndt_in_use_ = {};
+  points_in_use_ = {};
+  if (!keyframes_.empty()) startBuild(std::move(all), {});
 }
 
 void LocalMap::beginRegistration() {
-  if (!pending_.valid()) return;
-  const bool have_previous = in_use_.kd_tree != nullptr;
+  if (!pending_ndt_.valid()) return;
+  const bool have_previous = !ndt_in_use_.targets.empty() || points_in_use_.kd_tree != nullptr;
   if (have_previous && registrations_since_keyframe_++ < kScansOnPreviousMap) return;
-  finishPendingBuild();
+  // The NDT targets now; the points' structures at their first use, after the registration
+  // (the fitness), unless the registration searches them (GICP).
+  ndt_in_use_ = pending_ndt_.get();
+  points_due_ = true;
+  if (target_ == Target::kGicp) pointStructures();
 }
 
 void LocalMap::clear() {
@@ -137,7 +156,8 @@ void LocalMap::clear() {
   for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
   point_statistics_.clear();
   keyframes_.clear();
-  in_use_ = {};
+  ndt_in_use_ = {};
+  points_in_use_ = {};
 }
 
 std::size_t LocalMap::numPoints() const {
@@ -156,24 +176,28 @@ const T& inUse(const std::unique_ptr<T>& structure, const char* what) {
 
 std::vector<const registration::NdtTarget*> LocalMap::ndtTargets() const {
   std::vector<const registration::NdtTarget*> targets;
-  for (const auto& target : in_use_.ndt_targets) targets.push_back(target.get());
+  for (const auto& target : ndt_in_use_.targets) targets.push_back(target.get());
   if (targets.empty()) throw std::logic_error("LocalMap: no NDT target in use");
   return targets;
 }
-const registration::KdTree& LocalMap::kdTree() const { return inUse(in_use_.kd_tree, "kd-tree"); }
+const registration::KdTree& LocalMap::kdTree() const {
+  return inUse(pointStructures().kd_tree, "kd-tree");
+}
 const std::vector<Eigen::Vector3d>* LocalMap::pointsInUse() const {
-  return in_use_.kd_tree ? &in_use_.kd_tree->points() : nullptr;
+  const PointStructures& in_use = pointStructures();
+  return in_use.kd_tree ? &in_use.kd_tree->points() : nullptr;
 }
 const registration::Occupancy& LocalMap::occupancy(double voxel_m) const {
-  if (!in_use_.occupancy || in_use_.occupancy_voxel_m != voxel_m) {
-    in_use_.occupancy = std::make_unique<registration::Occupancy>(kdTree().points(), voxel_m);
-    in_use_.occupancy_voxel_m = voxel_m;
+  const PointStructures& in_use = pointStructures();
+  if (!in_use.occupancy || in_use.occupancy_voxel_m != voxel_m) {
+    in_use.occupancy = std::make_unique<registration::Occupancy>(kdTree().points(), voxel_m);
+    in_use.occupancy_voxel_m = voxel_m;
   }
-  return *in_use_.occupancy;
+  return *in_use.occupancy;
 }
 
 const registration::NdtTarget& LocalMap::coarseNdtTarget(double resolution_m) const {
-  std::unique_ptr<registration::NdtTarget>& target = in_use_.coarse_ndt_target;
+  std::unique_ptr<registration::NdtTarget>& target = pointStructures().coarse_ndt_target;
   if (!target || target->resolution_m() != resolution_m)
     target = std::make_unique<registration::NdtTarget>(registration::NdtTarget::fromPoints(
         kdTree().points(), resolution_m, ndt_cells_.cellsAt(resolution_m)));
@@ -181,7 +205,7 @@ const registration::NdtTarget& LocalMap::coarseNdtTarget(double resolution_m) co
 }
 
 const registration::GicpCloud& LocalMap::gicpCloud() const {
-  return inUse(in_use_.gicp_cloud, "GICP cloud");
+  return inUse(pointStructures().gicp_cloud, "GICP cloud");
 }
 
 }  // namespace taiga::pipeline

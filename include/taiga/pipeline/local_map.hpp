@@ -4,11 +4,15 @@
 // Its NDT cells come from incremental voxel statistics, so adding a keyframe and dropping the
 // oldest costs only their own points (registration/voxel_statistics.hpp).
 //
-// The search structures (NDT target or GICP cloud, and the kd-tree for the fitness score) are
-// rebuilt after each keyframe on a background thread (15-25 ms on an OS0-128 map), while the next
-// scan is registered against the previous structures. The hand-over is counted in scans, not in
-// time: the structures with keyframe k are used from the second registration after it, waiting
-// for the build if need be, so results do not depend on the machine's speed or load.
+// The search structures (NDT targets or GICP cloud, and the kd-tree for the fitness score) are
+// rebuilt after each keyframe by two background tasks, the NDT targets' and the points' (the
+// kd-tree's and GICP cloud's): 20-25 ms each on one core for an OS0-128 map
+// (bench/local_map_bench), while the next scan is registered against the previous structures.
+// The hand-over is counted in scans, not in time: the structures with keyframe k are used from
+// the second registration after it, waiting for the build if need be, so results do not depend
+// on the machine's speed or load. The NDT targets are handed over before that registration, the
+// points' structures at their first use (the fitness, after it), so their build has the
+// registration's time to finish.
 
 #include <Eigen/Core>
 #include <deque>
@@ -87,16 +91,20 @@ class LocalMap {
  private:
   /// Sets the NDT passes (coarse to fine, at least one); only while the map is empty.
   void setNdtResolutions(const std::vector<double>& ndt_resolutions_m);
-  struct SearchStructures {
-    std::vector<std::unique_ptr<registration::NdtTarget>> ndt_targets;  ///< coarse to fine
-    std::unique_ptr<registration::GicpCloud> gicp_cloud;
+  struct NdtStructures {
+    std::vector<std::unique_ptr<registration::NdtTarget>> targets;  ///< coarse to fine
+  };
+  struct PointStructures {
     std::unique_ptr<registration::KdTree> kd_tree;
+    std::unique_ptr<registration::GicpCloud> gicp_cloud;
     mutable std::unique_ptr<registration::Occupancy> occupancy;  ///< built on demand
     mutable double occupancy_voxel_m = 0.0;
     mutable std::unique_ptr<registration::NdtTarget> coarse_ndt_target;  ///< built on demand
   };
-  /// Waits for a background build and makes it the one in use.
+  /// Waits for the background builds and makes them the ones in use.
   void finishPendingBuild();
+  /// The points' structures in use, handed over first when beginRegistration() made them due.
+  const PointStructures& pointStructures() const;
 
   int max_keyframes_;
   Target target_;
@@ -108,16 +116,20 @@ class LocalMap {
     lie::SE3 T_odom_keyframe;
     std::vector<Eigen::Vector3d> points_in_keyframe;
   };
-  /// Adds keyframes' points, in the odom frame, to the statistics, removes others', and builds
-  /// the search structures from them.
-  SearchStructures update(const std::vector<const Keyframe*>& added,
-                          const std::vector<const Keyframe*>& removed);
+  /// Starts bringing the statistics up to date (adding keyframes' points in the odom frame,
+  /// removing others') and building the search structures from them, in the background.
+  void startBuild(std::vector<const Keyframe*> added, std::vector<const Keyframe*> removed);
 
   std::deque<Keyframe> keyframes_;
   std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
   registration::VoxelStatistics point_statistics_;  ///< one mean per point_spacing_m voxel
-  SearchStructures in_use_;
-  std::future<SearchStructures> pending_;  ///< reads the statistics: they wait for it
+  std::vector<Keyframe> dropped_;  ///< removed from the statistics by the pending build
+  NdtStructures ndt_in_use_;
+  mutable PointStructures points_in_use_;
+  // The pending builds read the statistics and keyframes: those wait for them.
+  std::future<NdtStructures> pending_ndt_;
+  mutable std::future<PointStructures> pending_points_;
+  mutable bool points_due_ = false;  ///< hand pending_points_ over at the next use
   int registrations_since_keyframe_ = 0;
 };
 
