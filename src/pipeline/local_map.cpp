@@ -51,14 +51,6 @@ const LocalMap::PointStructures& LocalMap::pointStructures() const {
   return points_in_use_;
 }
 
-namespace {
-/// A keyframe's local-map points in the odom frame, with their beams for the range noise.
-struct InOdom {
-  std::vector<Eigen::Vector3d> points;
-  registration::BeamNoise beams;
-};
-}  // namespace
-
 // The NDT targets and the points' structures are built by two tasks side by side, each from its
 // own statistics, so that the registration can start on the targets while the kd-tree is still
 // being built. Each statistic is updated and each structure built by one thread, in the same order
@@ -67,22 +59,20 @@ struct InOdom {
 void LocalMap::startBuild(std::vector<const Keyframe*> added,
                           std::vector<const Keyframe*> removed) {
   auto account = [this, added, removed](registration::VoxelStatistics& statistics) {
-    auto inOdom = [&](const Keyframe& keyframe) {
-      InOdom out{keyframe.points_in_keyframe,
-                 {keyframe.T_odom_keyframe * p_keyframe_lidar_, ndt_cells_.range_sigma_m,
-                  ndt_cells_.range_sigma_per_m}};
-      for (Eigen::Vector3d& p : out.points) p = keyframe.T_odom_keyframe * p;
-      return out;
+    auto apply = [&](const Keyframe& keyframe, int sign) {
+      std::vector<Eigen::Vector3d> points_in_odom = keyframe.points_in_keyframe;
+      for (Eigen::Vector3d& p : points_in_odom) p = keyframe.T_odom_keyframe * p;
+      // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
+      const registration::BeamNoise beams{keyframe.T_odom_keyframe * p_keyframe_lidar_,
+                                          ndt_cells_.range_sigma_m, ndt_cells_.range_sigma_per_m};
+      if (sign > 0) {
+        statistics.add(points_in_odom, beams);
+      } else {
+        statistics.remove(points_in_odom, beams);
+      }
     };
-    // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
-    for (const Keyframe* keyframe : added) {
-      const InOdom in_odom = inOdom(*keyframe);
-      statistics.add(in_odom.points, in_odom.beams);
-    }
-    for (const Keyframe* keyframe : removed) {
-      const InOdom in_odom = inOdom(*keyframe);
-      statistics.remove(in_odom.points, in_odom.beams);
-    }
+    for (const Keyframe* keyframe : added) apply(*keyframe, +1);
+    for (const Keyframe* keyframe : removed) apply(*keyframe, -1);
   };
   pending_ndt_ = std::async(std::launch::async, [this, account] {
     NdtStructures built;

@@ -99,6 +99,8 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
     throw std::logic_error("NdtTarget: stem cells need statistics with circle moments");
   }
   const std::vector<CellMoments> moments = stats.moments(cells.min_points_per_cell);
+  cells_.reserve(moments.size());
+  keys_.reserve(moments.size());
   std::vector<NotStem> not_stems;
   for (const CellMoments& m : moments) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(m.covariance);
