@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Per-stage time of `taiga run` from the runs' timing.csv and scans.csv (issue 26, "profile
 first"): for each stage the median, p95, p99 and max over the scans, the median of each run's
-value pooled over runs (medians of the per-run figures), and the scans right after a keyframe
-against the others (the keyframe spike).
+value pooled over runs (medians of the per-run figures), and the scans by how many scans came
+since the last keyframe (the keyframe spike).
 
 Usage: bench/stage_profile.py RUN_DIR [RUN_DIR...]
   Each RUN_DIR is a `taiga run --out` directory; give several runs of the same recording and
@@ -45,16 +45,21 @@ def figures(rows):
         v = [float(t[stage]) for t, _ in rows]
         out[stage] = (statistics.median(v), percentile(v, 95), percentile(v, 99), max(v),
                       statistics.fmean(v))
-    # The scan that becomes a keyframe pays for the keyframe (map_ms); the scan after it may
-    # wait for the local map's rebuild (registration_ms).
-    keyframe = [i for i, (_, s) in enumerate(rows) if s["keyframe"] == "1"]
-    after = [float(rows[i + 1][0]["total_ms"]) for i in keyframe if i + 1 < len(rows)]
-    at = [float(rows[i][0]["total_ms"]) for i in keyframe]
-    marked = set(keyframe) | {i + 1 for i in keyframe}
-    others = [float(t["total_ms"]) for i, (t, _) in enumerate(rows) if i not in marked]
-    out["keyframe scan"] = (statistics.median(at),) if at else (float("nan"),)
-    out["scan after a keyframe"] = (statistics.median(after),) if after else (float("nan"),)
-    out["other scans"] = (statistics.median(others),) if others else (float("nan"),)
+    # The scan that becomes a keyframe pays for the keyframe (map_ms); the second scan after it
+    # may wait for the local map's rebuild (registration_ms, LocalMap::kScansOnPreviousMap).
+    since = []
+    count = None
+    for _, s in rows:
+        count = 0 if s["keyframe"] == "1" else (None if count is None else count + 1)
+        since.append(count)
+    for group, label in ((0, "0 (the keyframe)"), (1, "1"), (2, "2"), (3, "3 and later")):
+        members = [t for (t, _), n in zip(rows, since)
+                   if n is not None and (n == group or (group == 3 and n >= 3))]
+        total = [float(t["total_ms"]) for t in members]
+        registration = [float(t["registration_ms"]) for t in members]
+        out[f"since {label}"] = (
+            (len(members), statistics.median(total), max(total), statistics.median(registration),
+             max(registration)) if members else (0,) + (float("nan"),) * 4)
     return out
 
 
@@ -69,9 +74,13 @@ def main():
     for stage in STAGES:
         cols = [statistics.median(r[stage][k] for r in per_run) for k in range(5)]
         print(f"| {stage[:-3]} | " + " | ".join(f"{c:.2f}" for c in cols) + " |")
-    for key in ("keyframe scan", "scan after a keyframe", "other scans"):
-        value = statistics.median(r[key][0] for r in per_run)
-        print(f"{key}: total {value:.2f} ms (median)")
+    print("\nby scans since the last keyframe (each the median over runs):")
+    print("| scans since the keyframe | scans | total median | total max | registration median "
+          "| registration max |")
+    print("|---|---|---|---|---|---|")
+    for key in [k for k in per_run[0] if k.startswith("since ")]:
+        cols = [statistics.median(r[key][k] for r in per_run) for k in range(5)]
+        print(f"| {key[6:]} | {cols[0]:.0f} | " + " | ".join(f"{c:.2f}" for c in cols[1:]) + " |")
 
 
 if __name__ == "__main__":
