@@ -31,6 +31,7 @@
 #include "taiga/preprocess/voxel_filter.hpp"
 #include "taiga/registration/kdtree.hpp"
 #include "taiga/registration/ndt.hpp"
+#include "taiga/registration/voxel_nearest.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
 using namespace taiga;
@@ -114,16 +115,18 @@ int main(int argc, char** argv) {
   rules.stem_cells_across_borders = o.ndt_stem_cells_across_borders;
 
   const char* names[] = {"point statistics", "NDT statistics", "NDT target", "means", "kd-tree",
-                         "sum"};
-  constexpr int kStages = 6;
-  std::vector<std::vector<double>> per_run(kStages);
+                         "sum", "grid (VoxelNearest)", "queries, kd-tree", "queries, grid"};
+  constexpr int kStages = 6, kExtras = 3;
+  std::vector<std::vector<double>> per_run(kStages + kExtras);
+  const double grid_cell_m = std::getenv("GRID_CELL") ? std::atof(std::getenv("GRID_CELL")) : 0.5;
+  std::size_t mismatches = 0;
   std::uint64_t hash = 0;
   std::size_t cells = 0, points = 0;
   for (int run = 0; run < runs; ++run) {
     registration::VoxelStatistics point_statistics(o.local_map_voxel_m);
     registration::VoxelStatistics ndt_statistics(o.ndt_resolution_m, rules.stem_cells);
     std::deque<const Keyframe*> window;
-    std::vector<std::vector<double>> ms(kStages);
+    std::vector<std::vector<double>> ms(kStages + kExtras);
     hash = 0;
     for (const Keyframe& keyframe : keyframes) {
       window.push_back(&keyframe);
@@ -152,16 +155,36 @@ int main(int argc, char** argv) {
       stage_ms[4] = msSince(start);
       for (int s = 0; s < kStages - 1; ++s) stage_ms[kStages - 1] += stage_ms[s];
       for (int s = 0; s < kStages; ++s) ms[s].push_back(stage_ms[s]);
+      // The fitness's queries: 4000 of the next keyframe's points, as a scan's would come.
+      start = Clock::now();
+      const registration::VoxelNearest grid(means, grid_cell_m);
+      ms[kStages].push_back(msSince(start));
+      const std::size_t k = static_cast<std::size_t>(&keyframe - keyframes.data());
+      if (k + 1 < keyframes.size()) {
+        const auto& next = keyframes[k + 1].points_in_odom;
+        std::vector<Eigen::Vector3d> sample;
+        for (std::size_t i = 0; i < next.size(); i += std::max<std::size_t>(1, next.size() / 4000))
+          sample.push_back(next[i]);
+        start = Clock::now();
+        const registration::Agreement a_tree = registration::agreement(sample, tree, {}, 2.0);
+        ms[kStages + 1].push_back(msSince(start));
+        start = Clock::now();
+        const registration::Agreement a_grid = registration::agreement(sample, grid, {}, 2.0);
+        ms[kStages + 2].push_back(msSince(start));
+        if (!(a_tree.fitness_m2 == a_grid.fitness_m2 && a_tree.share == a_grid.share)) ++mismatches;
+      }
       hash += checksum(target, tree.points());
       cells = target.cells().size();
       points = tree.size();
     }
-    for (int s = 0; s < kStages; ++s) per_run[s].push_back(median(ms[s]));
+    for (int s = 0; s < kStages + kExtras; ++s) per_run[s].push_back(median(ms[s]));
   }
   fmt::print("{} keyframes, {} in the map; at the end {} NDT cells of {} m, {} points of {} m\n",
              keyframes.size(), o.local_map_keyframes, cells, o.ndt_resolution_m, points,
              o.local_map_voxel_m);
   fmt::print("median ms per keyframe (one thread; median of {} runs):\n", runs);
-  for (int s = 0; s < kStages; ++s) fmt::print("  {:18s} {:7.2f}\n", names[s], median(per_run[s]));
+  for (int s = 0; s < kStages + kExtras; ++s)
+    fmt::print("  {:18s} {:7.2f}\n", names[s], median(per_run[s]));
+  fmt::print("agreement of the grid and the kd-tree differed on {} keyframes\n", mismatches);
   fmt::print("checksum {:016x}\n", hash);
 }

@@ -52,8 +52,8 @@ const LocalMap::PointStructures& LocalMap::pointStructures() const {
 }
 
 // The NDT targets and the points' structures are built by two tasks side by side, each from its
-// own statistics, so that the registration can start on the targets while the kd-tree is still
-// being built. Each statistic is updated and each structure built by one thread, in the same order
+// own statistics, so that the registration can start on the targets while the points' index is
+// still being built. Each statistic is updated and each structure built by one thread, in the same order
 // as before, so the result is the same on any number of threads. Removal subtracts exactly what
 // adding added: the same points through the same pose.
 void LocalMap::startBuild(std::vector<const Keyframe*> added,
@@ -88,10 +88,14 @@ void LocalMap::startBuild(std::vector<const Keyframe*> added,
   pending_points_ = std::async(std::launch::async, [this, account] {
     account(point_statistics_);
     PointStructures built;
-    const std::vector<Eigen::Vector3d> points = point_statistics_.means();
-    built.kd_tree = std::make_unique<registration::KdTree>(points);
-    if (target_ == Target::kGicp)
-      built.gicp_cloud = std::make_unique<registration::GicpCloud>(points, gicp_config_);
+    // The index buckets the means by its cells: they need no sort, and come out of it in an
+    // order local enough for the GICP cloud's kd-tree.
+    built.nearest = std::make_unique<registration::VoxelNearest>(
+        point_statistics_.meansInTableOrder(), kNearestCell_m);
+    if (target_ == Target::kGicp) {
+      built.gicp_cloud =
+          std::make_unique<registration::GicpCloud>(built.nearest->points(), gicp_config_);
+    }
     return built;
   });
 }
@@ -132,7 +136,7 @@ void LocalMap::repose(
 
 void LocalMap::beginRegistration() {
   if (!pending_ndt_.valid()) return;
-  const bool have_previous = !ndt_in_use_.targets.empty() || points_in_use_.kd_tree != nullptr;
+  const bool have_previous = !ndt_in_use_.targets.empty() || points_in_use_.nearest != nullptr;
   if (have_previous && registrations_since_keyframe_++ < kScansOnPreviousMap) return;
   // The NDT targets now; the points' structures at their first use, after the registration
   // (the fitness), unless the registration searches them (GICP).
@@ -170,17 +174,17 @@ std::vector<const registration::NdtTarget*> LocalMap::ndtTargets() const {
   if (targets.empty()) throw std::logic_error("LocalMap: no NDT target in use");
   return targets;
 }
-const registration::KdTree& LocalMap::kdTree() const {
-  return inUse(pointStructures().kd_tree, "kd-tree");
+const registration::VoxelNearest& LocalMap::nearest() const {
+  return inUse(pointStructures().nearest, "nearest-point index");
 }
 const std::vector<Eigen::Vector3d>* LocalMap::pointsInUse() const {
   const PointStructures& in_use = pointStructures();
-  return in_use.kd_tree ? &in_use.kd_tree->points() : nullptr;
+  return in_use.nearest ? &in_use.nearest->points() : nullptr;
 }
 const registration::Occupancy& LocalMap::occupancy(double voxel_m) const {
   const PointStructures& in_use = pointStructures();
   if (!in_use.occupancy || in_use.occupancy_voxel_m != voxel_m) {
-    in_use.occupancy = std::make_unique<registration::Occupancy>(kdTree().points(), voxel_m);
+    in_use.occupancy = std::make_unique<registration::Occupancy>(nearest().points(), voxel_m);
     in_use.occupancy_voxel_m = voxel_m;
   }
   return *in_use.occupancy;
@@ -190,7 +194,7 @@ const registration::NdtTarget& LocalMap::coarseNdtTarget(double resolution_m) co
   std::unique_ptr<registration::NdtTarget>& target = pointStructures().coarse_ndt_target;
   if (!target || target->resolution_m() != resolution_m)
     target = std::make_unique<registration::NdtTarget>(registration::NdtTarget::fromPoints(
-        kdTree().points(), resolution_m, ndt_cells_.cellsAt(resolution_m)));
+        nearest().points(), resolution_m, ndt_cells_.cellsAt(resolution_m)));
   return *target;
 }
 

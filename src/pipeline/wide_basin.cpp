@@ -43,7 +43,7 @@ WideBasin::WideBasin(const OdometryConfig& config)
 
 double WideBasin::overlap(const std::vector<Eigen::Vector3d>& source, const LocalMap& map,
                           const lie::SE3& T_odom_body) const {
-  return registration::agreement(source, map.kdTree(), T_odom_body, overlap_distance_m_).share;
+  return registration::agreement(source, map.nearest(), T_odom_body, overlap_distance_m_).share;
 }
 
 registration::RegistrationResult WideBasin::widen(const std::vector<Eigen::Vector3d>& source,

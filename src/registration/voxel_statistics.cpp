@@ -221,6 +221,13 @@ std::vector<Eigen::Vector3d> VoxelStatistics::means() const {
   return out;
 }
 
+std::vector<Eigen::Vector3d> VoxelStatistics::meansInTableOrder() const {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(cells_.size());
+  for (const auto& [key, sums] : cells_) out.push_back(meanOf(key, sums));
+  return out;
+}
+
 bool VoxelStatistics::operator==(const VoxelStatistics& other) const {
   return resolution_m_ == other.resolution_m_ && cells_ == other.cells_ &&
          circle_cells_ == other.circle_cells_;

@@ -4,10 +4,10 @@
 // Its NDT cells come from incremental voxel statistics, so adding a keyframe and dropping the
 // oldest costs only their own points (registration/voxel_statistics.hpp).
 //
-// The search structures (NDT targets or GICP cloud, and the kd-tree for the fitness score) are
-// rebuilt after each keyframe by two background tasks, the NDT targets' and the points' (the
-// kd-tree's and GICP cloud's): 20-25 ms each on one core for an OS0-128 map
-// (bench/local_map_bench), while the next scan is registered against the previous structures.
+// The search structures (NDT targets or GICP cloud, and the points' nearest-point index for the
+// fitness score) are rebuilt after each keyframe by two background tasks, the NDT targets' (about
+// 20 ms on one core for an OS0-128 map) and the points' (about 10 ms; bench/local_map_bench),
+// while the next scan is registered against the previous structures.
 // The hand-over is counted in scans, not in time: the structures with keyframe k are used from
 // the second registration after it, waiting for the build if need be, so results do not depend
 // on the machine's speed or load. The NDT targets are handed over before that registration, the
@@ -24,8 +24,8 @@
 #include "taiga/lie/se3.hpp"
 #include "taiga/registration/correlative_search.hpp"
 #include "taiga/registration/gicp.hpp"
-#include "taiga/registration/kdtree.hpp"
 #include "taiga/registration/ndt.hpp"
+#include "taiga/registration/voxel_nearest.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
 namespace taiga::pipeline {
@@ -39,10 +39,12 @@ class LocalMap {
   /// keyframe often waits for them; 2 removed that wait but lost a lidar-only walk's
   /// relocalization after a blind stretch (bench/BENCHMARK.md, "Session 37").
   static constexpr int kScansOnPreviousMap = 1;
+  /// The cells of the points' nearest-point index: the fitness searches 2 m, and 1 m cells built
+  /// and searched fastest (bench/local_map_bench; 0.3-1.3 m tried).
+  static constexpr double kNearestCell_m = 1.0;
 
-  /// NDT cells at each of ndt_resolutions_m (coarse to fine, at least one); the kd-tree
-  /// (fitness, GICP) over one point per point_spacing_m voxel, so overlapping keyframes do not
-  /// multiply its size.
+  /// NDT cells at each of ndt_resolutions_m (coarse to fine, at least one); the points (fitness,
+  /// GICP) one per point_spacing_m voxel, so overlapping keyframes do not multiply their number.
   /// `ndt`: the cell rules of the NDT targets (NdtTarget; not its resolutions); with its range
   /// noise set, the stem cells take it out along each point's beam from the lidar at
   /// `p_keyframe_lidar` (the lidar's position in a keyframe's frame).
@@ -75,15 +77,17 @@ class LocalMap {
 
   /// The structures in use (logic_error for the other target's); the NDT targets coarse to fine.
   std::vector<const registration::NdtTarget*> ndtTargets() const;
-  const registration::KdTree& kdTree() const;
+  /// The local map's points (one per point_spacing_m voxel) for nearest-point queries (the
+  /// fitness, the wide basin's overlap).
+  const registration::VoxelNearest& nearest() const;
   /// The points the registration searches now (one per point_spacing_m voxel, odom frame), or
   /// nullptr before the first build: what a viewer shows as the local map.
   const std::vector<Eigen::Vector3d>* pointsInUse() const;
   const registration::GicpCloud& gicpCloud() const;
-  /// The voxels (of edge voxel_m) that the kd-tree's points occupy, for the correlative search;
+  /// The voxels (of edge voxel_m) that the points occupy, for the correlative search;
   /// built at the first call on the structures in use (none is built for maps never searched).
   const registration::Occupancy& occupancy(double voxel_m) const;
-  /// NDT cells of edge resolution_m over the kd-tree's points, for a first pass from a guess that
+  /// NDT cells of edge resolution_m over the points, for a first pass from a guess that
   /// may be decimetres and degrees off (across a gap in the IMU readings) on a map whose own
   /// cells are only fine; built at the first call on the structures in use, like occupancy().
   const registration::NdtTarget& coarseNdtTarget(double resolution_m) const;
@@ -95,7 +99,7 @@ class LocalMap {
     std::vector<std::unique_ptr<registration::NdtTarget>> targets;  ///< coarse to fine
   };
   struct PointStructures {
-    std::unique_ptr<registration::KdTree> kd_tree;
+    std::unique_ptr<registration::VoxelNearest> nearest;
     std::unique_ptr<registration::GicpCloud> gicp_cloud;
     mutable std::unique_ptr<registration::Occupancy> occupancy;  ///< built on demand
     mutable double occupancy_voxel_m = 0.0;
