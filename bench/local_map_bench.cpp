@@ -4,9 +4,10 @@
 // Stages: the point statistics' update (one mean per local_map_voxel_m voxel), the NDT cells'
 // statistics' update (with the range noise's shares), the NDT target's build, the means and the
 // nearest-point index over them (and, for comparison, the kd-tree it replaced and the fitness's
-// queries in both, which must agree bit for bit). Each stage's median over the keyframes is printed, then the median over RUNS
-// passes. In `taiga run` this runs beside the scans' registration, on the same two cores: the
-// scan after next waits for it (bench/BENCHMARK.md, "Session 65").
+// queries in both, which must agree bit for bit). Each stage's median over the keyframes is
+// printed, then the median over RUNS passes. In `taiga run` this runs beside the scans'
+// registration, on the same two cores: the scan after next waits for it (bench/BENCHMARK.md,
+// "Session 65").
 //
 // The last line is a checksum of what the structures hold (every NDT cell and indexed point, bit
 // for bit, in any order): an optimization that should not change them must not change it.
@@ -119,9 +120,15 @@ int main(int argc, char** argv) {
   // The stages LocalMap runs, then for comparison the kd-tree it used before (over the means
   // sorted by key) and the fitness's queries in either: 4000 of the next keyframe's points, as a
   // scan's would come, within 2 m (two coarse NDT cells).
-  const char* names[] = {"point statistics", "NDT statistics", "NDT target", "means",
-                         "nearest index", "sum", "sorted means + kd-tree (before)",
-                         "queries, kd-tree", "queries, index"};
+  const char* names[] = {"point statistics",
+                         "NDT statistics",
+                         "NDT target",
+                         "means",
+                         "nearest index",
+                         "sum",
+                         "sorted means + kd-tree (before)",
+                         "queries, kd-tree",
+                         "queries, index"};
   constexpr int kStages = 6, kExtras = 3;
   std::vector<std::vector<double>> per_run(kStages + kExtras);
   std::size_t mismatches = 0;

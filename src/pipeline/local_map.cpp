@@ -53,9 +53,9 @@ const LocalMap::PointStructures& LocalMap::pointStructures() const {
 
 // The NDT targets and the points' structures are built by two tasks side by side, each from its
 // own statistics, so that the registration can start on the targets while the points' index is
-// still being built. Each statistic is updated and each structure built by one thread, in the same order
-// as before, so the result is the same on any number of threads. Removal subtracts exactly what
-// adding added: the same points through the same pose.
+// still being built. Each statistic is updated and each structure built by one thread, in the same
+// order as before, so the result is the same on any number of threads. Removal subtracts exactly
+// what adding added: the same points through the same pose.
 void LocalMap::startBuild(std::vector<const Keyframe*> added,
                           std::vector<const Keyframe*> removed) {
   auto account = [this, added, removed](registration::VoxelStatistics& statistics) {

@@ -264,10 +264,10 @@ registration::RegistrationResult Odometry::alignToMap(
     result.iterations = iterations;
   }
   // Points farther than a few coarse NDT cells from the map are new ground, not misalignment.
-  result.fitness_m2 = registration::agreement(fitnessSample(source.points), local_map_.nearest(),
-                                              result.T_target_source,
-                                              2.0 * config_.coarsestNdtResolutionM())
-                          .fitness_m2;
+  result.fitness_m2 =
+      registration::agreement(fitnessSample(source.points), local_map_.nearest(),
+                              result.T_target_source, 2.0 * config_.coarsestNdtResolutionM())
+          .fitness_m2;
   return result;
 }
 

@@ -89,10 +89,10 @@ bool VoxelNearest::nearestWithin(const Eigen::Vector3d& query, double max_distan
       lo[a] = centre[a] - k;
       hi[a] = centre[a] + k;
       if (std::isfinite(reach_m)) {
-        lo[a] = std::max(lo[a], static_cast<std::int64_t>(
-                                    std::floor((query[a] - reach_m) * inverse_cell_)));
-        hi[a] = std::min(hi[a], static_cast<std::int64_t>(
-                                    std::floor((query[a] + reach_m) * inverse_cell_)));
+        lo[a] = std::max(
+            lo[a], static_cast<std::int64_t>(std::floor((query[a] - reach_m) * inverse_cell_)));
+        hi[a] = std::min(
+            hi[a], static_cast<std::int64_t>(std::floor((query[a] + reach_m) * inverse_cell_)));
       }
       lo[a] = std::max(lo[a], low_[a]);
       hi[a] = std::min(hi[a], high_[a]);
