@@ -39,8 +39,14 @@ VoxelNearest::VoxelNearest(std::span<const Eigen::Vector3d> points, double cell_
   std::vector<std::uint32_t> cell_of_point(points.size(), kOutside);
   std::vector<std::uint32_t> counts;
   for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) continue;  // never anyone's nearest
     const VoxelKey key = voxelOf(points[i], inverse_cell_);
-    if (key == kInvalidVoxel) continue;  // beyond the grid (1e6 cells from the origin) or NaN
+    if (key == kInvalidVoxel) {
+      throw std::invalid_argument(
+          "VoxelNearest: a point lies beyond the grid's 1e6 cells from the origin (" +
+          std::to_string(points[i].norm()) + " m at cells of " + std::to_string(cell_m) +
+          " m): express the points in a local frame");
+    }
     const auto [it, inserted] =
         cell_of_key.try_emplace(key, static_cast<std::uint32_t>(keys.size()));
     if (inserted) {

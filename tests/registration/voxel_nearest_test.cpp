@@ -96,6 +96,12 @@ TEST(VoxelNearest, EmptyAndBadInput) {
   EXPECT_THROW(VoxelNearest(std::vector<Eigen::Vector3d>{}, 0.0), std::invalid_argument);
   const VoxelNearest one(std::vector<Eigen::Vector3d>{{1.0, 2.0, 3.0}}, 0.5);
   EXPECT_FALSE(one.nearestWithin(Eigen::Vector3d(std::nan(""), 0.0, 0.0), 10.0, i, d));
+  // Non-finite points are left out; points beyond the grid are refused, not dropped.
+  const VoxelNearest with_nan(
+      std::vector<Eigen::Vector3d>{{std::nan(""), 0.0, 0.0}, {1.0, 2.0, 3.0}}, 0.5);
+  EXPECT_EQ(with_nan.size(), 1u);
+  EXPECT_THROW(VoxelNearest(std::vector<Eigen::Vector3d>{{7.0e6, 0.0, 0.0}}, 1.0),
+               std::invalid_argument);
   ASSERT_TRUE(one.nearestWithin(Eigen::Vector3d(-100.0, 2.0, 3.0), 200.0, i, d));
   EXPECT_EQ(d, 101.0 * 101.0);
 }

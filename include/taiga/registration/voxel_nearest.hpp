@@ -22,7 +22,9 @@ namespace taiga::registration {
 
 class VoxelNearest {
  public:
-  /// The points (any order; kept bucketed by cell) in cells of `cell_m` (> 0) metres.
+  /// The points (any order; kept bucketed by cell) in cells of `cell_m` (> 0) metres;
+  /// non-finite points are left out. std::invalid_argument for a bad cell_m or a point more than
+  /// 1e6 cells from the origin (a map in a projected CRS at small cells: use a local frame).
   VoxelNearest(std::span<const Eigen::Vector3d> points, double cell_m);
 
   std::size_t size() const { return points_.size(); }
