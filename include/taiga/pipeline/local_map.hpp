@@ -6,7 +6,7 @@
 //
 // The search structures (NDT targets or GICP cloud, and the points' nearest-point index for the
 // fitness score) are rebuilt after each keyframe by two background tasks, the NDT targets' (about
-// 20 ms on one core for an OS0-128 map) and the points' (about 10 ms; bench/local_map_bench),
+// 20 ms on one core for an OS0-128 map) and the points' (about 13 ms; bench/local_map_bench),
 // while the next scan is registered against the previous structures.
 // The hand-over is counted in scans, not in time: the structures with keyframe k are used from
 // the second registration after it, waiting for the build if need be, so results do not depend
