@@ -25,7 +25,6 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -35,6 +34,7 @@
 #include <vector>
 
 #include "../tests/registration/forest_case.hpp"
+#include "bench_common.hpp"
 #include "taiga/core/angles.hpp"
 #include "taiga/core/trajectory.hpp"
 #include "taiga/preprocess/deskew.hpp"
@@ -47,12 +47,9 @@
 namespace {
 
 using namespace taiga;
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::msSince;
 using namespace taiga::test;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const Points& points) {
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();

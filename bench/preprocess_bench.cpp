@@ -10,12 +10,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "taiga/core/system_config.hpp"
 #include "taiga/io/config_yaml.hpp"
 #include "taiga/io/recording.hpp"
@@ -25,25 +25,15 @@
 #include "taiga/preprocess/voxel_filter.hpp"
 
 using namespace taiga;
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::median;
+using bench::msSince;
 
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
 /// FNV-1a over the bytes of the points, continued from `hash`.
 std::uint64_t checksum(const std::vector<Eigen::Vector3d>& points, std::uint64_t hash) {
-  const auto* bytes = reinterpret_cast<const unsigned char*>(points.data());
-  for (std::size_t i = 0; i < points.size() * sizeof(Eigen::Vector3d); ++i)
-    hash = (hash ^ bytes[i]) * 0x100000001b3ULL;
-  return hash;
-}
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  return bench::fnv1a(points.data(), points.size() * sizeof(Eigen::Vector3d), hash);
 }
 
 }  // namespace
@@ -74,7 +64,7 @@ int main(int argc, char** argv) {
   const char* names[] = {"crop", "deskew", "voxel (scan)", "voxel (keyframe)", "sum"};
   std::vector<std::vector<double>> per_run(5);
   std::size_t points = 0, kept = 0, voxels = 0;
-  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  std::uint64_t hash = bench::kFnvOffset;
   for (int run = 0; run < runs; ++run) {
     std::vector<std::vector<double>> ms(5);
     for (const io::Scan& scan : scans) {
