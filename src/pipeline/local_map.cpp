@@ -56,23 +56,40 @@ const LocalMap::PointStructures& LocalMap::pointStructures() const {
 // still being built. Each statistic is updated and each structure built by one thread, in the same
 // order as before, so the result is the same on any number of threads. Removal subtracts exactly
 // what adding added: the same points through the same pose.
-void LocalMap::startBuild(std::vector<const Keyframe*> added,
-                          std::vector<const Keyframe*> removed) {
-  auto account = [this, added, removed](registration::VoxelStatistics& statistics) {
-    auto apply = [&](const Keyframe& keyframe, int sign) {
-      std::vector<Eigen::Vector3d> points_in_odom = keyframe.points_in_keyframe;
-      for (Eigen::Vector3d& p : points_in_odom) p = keyframe.T_odom_keyframe * p;
-      // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
-      const registration::BeamNoise beams{keyframe.T_odom_keyframe * p_keyframe_lidar_,
-                                          ndt_cells_.range_sigma_m, ndt_cells_.range_sigma_per_m};
-      if (sign > 0) {
-        statistics.add(points_in_odom, beams);
+void LocalMap::startBuild(const std::vector<const Keyframe*>& added,
+                          const std::vector<const Keyframe*>& removed) {
+  // The keyframes' points in the odom frame, once for both tasks, with the rotation matrix made
+  // once: each task applying SE3::act to every point (14.8 ns a point, bench/lie_bench) spent
+  // about 0.8 ms of a keyframe; here it adds about 0.4 ms to the keyframe's scan (map_ms median
+  // 3.8 -> 4.1 ms; real-time factor and p99 unchanged, bench/odometry_speed.sh).
+  struct InOdom {
+    std::vector<Eigen::Vector3d> points;
+    registration::BeamNoise beams;
+    int sign;  ///< +1 added, -1 removed
+  };
+  auto in_odom = std::make_shared<std::vector<InOdom>>();
+  auto put = [&](const Keyframe& keyframe, int sign) {
+    const Eigen::Matrix3d R = keyframe.T_odom_keyframe.rotation().matrix();
+    const Eigen::Vector3d t = keyframe.T_odom_keyframe.translation();
+    InOdom out{{},
+               {R * p_keyframe_lidar_ + t, ndt_cells_.range_sigma_m, ndt_cells_.range_sigma_per_m},
+               sign};
+    out.points.reserve(keyframe.points_in_keyframe.size());
+    for (const Eigen::Vector3d& p : keyframe.points_in_keyframe)
+      out.points.push_back(R * p + t);  // as SE3::act, bit for bit
+    in_odom->push_back(std::move(out));
+  };
+  for (const Keyframe* keyframe : added) put(*keyframe, +1);
+  for (const Keyframe* keyframe : removed) put(*keyframe, -1);
+  // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
+  auto account = [in_odom](registration::VoxelStatistics& statistics) {
+    for (const InOdom& keyframe : *in_odom) {
+      if (keyframe.sign > 0) {
+        statistics.add(keyframe.points, keyframe.beams);
       } else {
-        statistics.remove(points_in_odom, beams);
+        statistics.remove(keyframe.points, keyframe.beams);
       }
-    };
-    for (const Keyframe* keyframe : added) apply(*keyframe, +1);
-    for (const Keyframe* keyframe : removed) apply(*keyframe, -1);
+    }
   };
   pending_ndt_ = std::async(std::launch::async, [this, account] {
     NdtStructures built;
@@ -113,7 +130,7 @@ void LocalMap::addKeyframe(std::uint64_t id, const lie::SE3& T_odom_keyframe,
   // "Session 37"). Nothing else reads them until finishPendingBuild().
   std::vector<const Keyframe*> removed;
   for (const Keyframe& keyframe : dropped_) removed.push_back(&keyframe);
-  startBuild({&keyframes_.back()}, std::move(removed));
+  startBuild({&keyframes_.back()}, removed);
   registrations_since_keyframe_ = 0;
 }
 
@@ -131,7 +148,7 @@ void LocalMap::repose(
   // No structures in use: beginRegistration() waits for those in the new frame.
   ndt_in_use_ = {};
   points_in_use_ = {};
-  if (!keyframes_.empty()) startBuild(std::move(all), {});
+  if (!keyframes_.empty()) startBuild(all, {});
 }
 
 void LocalMap::beginRegistration() {

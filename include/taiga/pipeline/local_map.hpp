@@ -122,7 +122,8 @@ class LocalMap {
   };
   /// Starts bringing the statistics up to date (adding keyframes' points in the odom frame,
   /// removing others') and building the search structures from them, in the background.
-  void startBuild(std::vector<const Keyframe*> added, std::vector<const Keyframe*> removed);
+  void startBuild(const std::vector<const Keyframe*>& added,
+                  const std::vector<const Keyframe*>& removed);
 
   std::deque<Keyframe> keyframes_;
   std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
