@@ -216,7 +216,7 @@ void LasWriter::appendRecords(const PointCloud& cloud, const LasPointFields& fie
   }
   out_.seekp(0, std::ios::end);
   out_.write(records.data().data(), static_cast<std::streamsize>(records.data().size()));
-  if (!out_) throw InputError(fmt::format("{}: write failed", path_.string()));
+  if (!out_) throw writeFailed(path_);
   count_ += cloud.size();
 }
 
@@ -225,7 +225,7 @@ void LasWriter::close() {
   closed_ = true;
   writeHeader();
   out_.close();
-  if (!out_) throw InputError(fmt::format("{}: write failed", path_.string()));
+  if (!out_) throw writeFailed(path_);
 }
 
 }  // namespace taiga::io

@@ -55,7 +55,7 @@ std::FILE* openForWriting(const std::filesystem::path& path) {
 void closeWritten(std::FILE* file, const std::filesystem::path& path) {
   const bool failed = std::ferror(file) != 0;
   if (std::fclose(file) != 0 || failed) {
-    throw InputError(fmt::format("{}: write failed", path.string()));
+    throw writeFailed(path);
   }
 }
 

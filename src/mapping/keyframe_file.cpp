@@ -151,7 +151,7 @@ void writeKeyframeFile(const std::filesystem::path& path, std::uint64_t id, doub
   if (!out) throw InputError(fmt::format("{}: cannot write the keyframe file", path.string()));
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   out.close();
-  if (!out) throw InputError(fmt::format("{}: write failed (disk full?)", path.string()));
+  if (!out) throw writeFailed(path);
 }
 
 KeyframeFileContent decodeKeyframe(std::string_view bytes, std::string_view source_name) {

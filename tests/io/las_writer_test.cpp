@@ -123,6 +123,17 @@ TEST(LasWriter, RejectsCoordinatesBeyondTheIntegerRange) {
   EXPECT_THAT(messageOf<InputError>([&] { LasWriter(dir.file("missing/dir/x.las")); }), HasSubstr("cannot open for writing"));
 }
 
+// A full disk (Linux's /dev/full fails every write with ENOSPC) is named as such, with the file.
+TEST(LasWriter, AFullDiskIsSaidWithTheFile) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  LasWriter writer("/dev/full");
+  const std::string message = messageOf<InputError>([&] {
+    writer.append(helsinkiCloud(200000, 0.0));  // 7 MB: more than the stream's buffer
+    writer.close();
+  });
+  EXPECT_THAT(message, HasSubstr("/dev/full: write failed: No space left on device"));
+}
+
 }  // namespace
 }  // namespace taiga::io
 

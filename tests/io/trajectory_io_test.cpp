@@ -127,5 +127,11 @@ TEST(TrajectoryIo, KittiRejectsNonRotationsAndMismatchedTimes) {
               HasSubstr("odd.txt:1: found 3 values; expected 8 (TUM"));
 }
 
+TEST(TrajectoryIo, AFullDiskIsSaidWithTheFile) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  EXPECT_THAT(messageOf<InputError>([&] { writeTum("/dev/full", randomTrajectory(10)); }),
+              HasSubstr("/dev/full: write failed: No space left on device"));
+}
+
 }  // namespace
 }  // namespace taiga::io

@@ -1,6 +1,7 @@
 #pragma once
 // Exceptions that carry a message meant for the user. Internal invariants use assert() instead.
 
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -18,5 +19,10 @@ class OutOfRangeError : public std::out_of_range {
  public:
   using std::out_of_range::out_of_range;
 };
+
+/// The error for a file that could not be written or closed: names the file, the system's reason
+/// (errno, e.g. "No space left on device") and the space left on its file system, so a full disk
+/// is told apart from a damaged one. Call it right after the failed write, before errno changes.
+InputError writeFailed(const std::filesystem::path& path);
 
 }  // namespace taiga
