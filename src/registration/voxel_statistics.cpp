@@ -38,8 +38,12 @@ VoxelStatistics::VoxelStatistics(double resolution_m, bool circle_moments)
 }
 
 namespace {
-// Not llround: a noise share of a large cell or a loud lidar passes 2^63 quanta^4.
-Int128 roundedToInt128(double value) { return static_cast<Int128>(std::round(value)); }
+// A noise share of a large cell or a loud lidar passes 2^63 quanta^4: beyond 2^62, through
+// double -> 128 bits (a library call); below, llround gives the same integer, inline.
+Int128 roundedToInt128(double value) {
+  if (std::abs(value) < 0x1p62) return std::llround(value);
+  return static_cast<Int128>(std::round(value));
+}
 }  // namespace
 
 void VoxelStatistics::addNoiseShare(const Eigen::Vector3d& p, const std::int64_t q[3],
