@@ -2,11 +2,7 @@
 
 #include <fmt/format.h>
 
-#include <condition_variable>
-#include <exception>
-#include <future>
 #include <list>
-#include <map>
 #include <unordered_map>
 
 #include "taiga/core/errors.hpp"
@@ -89,43 +85,13 @@ struct KeyframeStore::Impl {
 
   std::filesystem::path dir;
   KeyframeStoreOptions options;
-  mutable std::mutex mutex;  // guards infos, unwritten, files_written and write_error
+  mutable std::mutex mutex;  // guards infos
   std::vector<KeyframeInfo> infos;
-  // The scans whose files are being written, served from RAM by load() until they are on disk.
-  std::map<std::uint64_t, std::shared_ptr<const PointCloud>> unwritten;
-  std::uint64_t files_written = 0;  ///< keyframes 0 .. files_written - 1 are on disk
-  std::exception_ptr write_error;   ///< the first write that failed; no file is written after it
-  mutable std::condition_variable written;  ///< signalled when a file is written or fails
   // Its own lock, never held together with `mutex`: a cache miss reads a file without either.
   mutable std::mutex cache_mutex;  // guards registration_cache and the counters
   mutable RegistrationCache registration_cache;
   mutable std::uint64_t registration_cache_hits = 0;
   mutable std::uint64_t registration_copies_rebuilt = 0;
-  // Last: destroyed first, its destructor waits for the write in flight, which uses the above.
-  std::future<void> writing;  ///< the newest background write (add() and flush() only)
-
-  std::filesystem::path pathOf(std::uint64_t id) const {
-    return dir / fmt::format("{:06d}.tkf", id);
-  }
-
-  /// Writes keyframe `id`'s file (the background job).
-  void write(std::uint64_t id, double t_s, const PointCloud& cloud) {
-    try {
-      writeKeyframeFile(pathOf(id), id, t_s, cloud);
-      const std::lock_guard lock(mutex);
-      unwritten.erase(id);
-      ++files_written;
-    } catch (...) {
-      const std::lock_guard lock(mutex);
-      write_error = std::current_exception();
-    }
-    written.notify_all();
-  }
-
-  /// Rethrows a failed write (call with `mutex` held).
-  void rethrowWriteError() const {
-    if (write_error) std::rethrow_exception(write_error);
-  }
 
   const KeyframeInfo& at(std::uint64_t id) const {
     if (id >= infos.size())
@@ -185,43 +151,32 @@ KeyframeStore KeyframeStore::open(const std::filesystem::path& dir, KeyframeStor
 }
 
 std::uint64_t KeyframeStore::add(double t_s, const lie::SE3& T_odom_body,
-                                 std::shared_ptr<const PointCloud> cloud_in_body,
+                                 const PointCloud& cloud_in_body,
                                  const std::vector<Eigen::Vector3d>* registration_positions) {
-  // One write in flight at most, so that a slow disk cannot pile up scans in RAM. A keyframe
-  // comes every 0.5-1 s and a file takes a few ms: this rarely waits.
-  if (impl_->writing.valid()) impl_->writing.wait();
   std::uint64_t id = 0;
   {
     const std::lock_guard lock(impl_->mutex);
-    impl_->rethrowWriteError();
     id = impl_->infos.size();
     if (!impl_->infos.empty() && !(t_s > impl_->infos.back().t_s))
       throw std::invalid_argument(
           fmt::format("KeyframeStore::add: time {} is not after {}", t_s, impl_->infos.back().t_s));
-    impl_->unwritten.emplace(id, cloud_in_body);
-    impl_->infos.push_back(KeyframeInfo{
-        .id = id, .t_s = t_s, .T_map_body = T_odom_body, .point_count = cloud_in_body->size()});
   }
+  // The slow parts (file, voxel filter) outside the lock: readers of other keyframes go on.
+  writeKeyframeFile(keyframePath(id), id, t_s, cloud_in_body);
+  KeyframeInfo info{
+      .id = id, .t_s = t_s, .T_map_body = T_odom_body, .point_count = cloud_in_body.size()};
   if (impl_->options.registration_voxel_m > 0.0) {
     // The newest keyframe is the one loop closure asks for next: cache its copy now, from the
-    // scan at hand (or the caller's filtering of it) rather than read the file back.
-    std::shared_ptr<const PointCloud> copy = registration_positions != nullptr
-                                                 ? positionsOnly(*registration_positions)
-                                                 : registrationCopy(*cloud_in_body, impl_->options);
+    // scan at hand (or the caller's filtering of it), rather than read the file back.
+    std::shared_ptr<const PointCloud> registration =
+        registration_positions != nullptr ? positionsOnly(*registration_positions)
+                                          : registrationCopy(cloud_in_body, impl_->options);
     const std::lock_guard cache_lock(impl_->cache_mutex);
-    impl_->registration_cache.insert(id, std::move(copy));
+    impl_->registration_cache.insert(id, std::move(registration));
   }
-  impl_->writing = std::async(std::launch::async,
-                              [impl = impl_.get(), id, t_s, cloud = std::move(cloud_in_body)] {
-                                impl->write(id, t_s, *cloud);
-                              });
-  return id;
-}
-
-void KeyframeStore::flush() {
-  if (impl_->writing.valid()) impl_->writing.wait();
   const std::lock_guard lock(impl_->mutex);
-  impl_->rethrowWriteError();
+  impl_->infos.push_back(info);
+  return id;
 }
 
 std::size_t KeyframeStore::size() const {
@@ -232,17 +187,11 @@ std::size_t KeyframeStore::size() const {
 const std::filesystem::path& KeyframeStore::directory() const { return impl_->dir; }
 
 std::filesystem::path KeyframeStore::keyframePath(std::uint64_t id) const {
-  return impl_->pathOf(id);
+  return impl_->dir / fmt::format("{:06d}.tkf", id);
 }
 
 PointCloud KeyframeStore::load(std::uint64_t id) const {
-  KeyframeInfo info;
-  {
-    const std::lock_guard lock(impl_->mutex);
-    info = impl_->at(id);
-    // Not on disk yet: the scan as add() was given it, which the file will hold bit for bit.
-    if (const auto it = impl_->unwritten.find(id); it != impl_->unwritten.end()) return *it->second;
-  }
+  const KeyframeInfo info = this->info(id);
   KeyframeFileContent content = readKeyframeFile(keyframePath(id));
   if (content.header.id != id || content.header.point_count != info.point_count) {
     throw InputError(
@@ -316,14 +265,6 @@ void KeyframeStore::writePoses(const Trajectory& poses_T_map_body) const {
   if (poses_T_map_body.size() > size())
     throw std::invalid_argument(fmt::format("KeyframeStore::writePoses: {} poses for {} keyframes",
                                             poses_T_map_body.size(), size()));
-  {
-    // The files it lists first: open() takes every keyframe poses.tum lists as complete.
-    std::unique_lock lock(impl_->mutex);
-    impl_->written.wait(lock, [&] {
-      return impl_->write_error || impl_->files_written >= poses_T_map_body.size();
-    });
-    impl_->rethrowWriteError();
-  }
   const std::filesystem::path path = impl_->dir / kPosesFile;
   const std::filesystem::path temporary = impl_->dir / (std::string(kPosesFile) + ".tmp");
   io::writeTum(temporary, poses_T_map_body);

@@ -324,7 +324,7 @@ void Odometry::maybeAddKeyframe(ScanOutcome& outcome, PointCloud&& cloud_in_body
   last_keyframe_T_odom_body_ = outcome.T_odom_body;
   local_map_.addKeyframe(*outcome.keyframe_id, outcome.T_odom_body,
                          preparation_->localMapPoints(cloud_in_body));
-  outcome.keyframe_cloud_in_body = std::make_shared<const PointCloud>(std::move(cloud_in_body));
+  outcome.keyframe_cloud_in_body = std::move(cloud_in_body);
 }
 
 }  // namespace taiga::pipeline

@@ -124,6 +124,13 @@ TEST(SlamSystem, LidarOnlyPublishesEveryScanOnceInOrderAndFollowsTheWalk) {
   // finish() gave the store the graph's final poses.
   for (std::size_t k = 0; k < slam.keyframes().size(); ++k)
     EXPECT_EQ(slam.keyframes().pose(k).matrix(), mapper.graph().pose(k).matrix());
+  // The registration copies the store was handed (the odometry's source clouds) are those it
+  // makes from the keyframe files itself, bit for bit.
+  const mapping::KeyframeStore reopened = mapping::KeyframeStore::open(
+      dir.path() / "keyframes", {.registration_voxel_m = SystemConfig().odometry.voxel_size_m});
+  for (std::size_t k = 0; k < slam.keyframes().size(); ++k)
+    EXPECT_EQ(slam.keyframes().registrationCloud(k)->positions,
+              reopened.registrationCloud(k)->positions);
 }
 
 TEST(SlamSystem, WithAnImuNothingIsPublishedBeforeTheOdomFrameIsLevelled) {

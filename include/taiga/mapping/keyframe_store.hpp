@@ -2,10 +2,8 @@
 // Keyframes on disk, so that memory stays flat however long the recording (issue 7, item 4).
 //
 // add() writes the keyframe's full-resolution deskewed scan (body frame) to
-// DIR/NNNNNN.tkf (keyframe_file.hpp) and keeps in RAM only what the mapping needs often: time,
-// pose and point count. The file is written by a background job, one at a time, off the caller's
-// thread (on the odometry's thread it cost 3-5 ms per keyframe, bench/BENCHMARK.md "Session 68");
-// until it is on disk, load() serves the scan from RAM. When registration_voxel_m > 0, registrationCloud() gives a
+// DIR/NNNNNN.tkf (keyframe_file.hpp) at once and keeps in RAM only what the mapping needs
+// often: time, pose and point count. When registration_voxel_m > 0, registrationCloud() gives a
 // voxel-filtered, positions-only copy of the scan for loop closure; only the
 // registration_cache_keyframes most recently used copies stay in RAM (least recently used
 // evicted), and a copy not cached is rebuilt from the keyframe file with the same deterministic
@@ -15,8 +13,8 @@
 // per keyframe in id order), so that `taiga export-map DIR` re-exports a finished run with its
 // final poses, or a running one with its current poses.
 //
-// Ids are 0, 1, 2, ... in the order of add(). Thread-safe: one thread may add() and flush()
-// while others call load(), registrationCloud(), pose(), setPoses() or writePoses(). A registration copy handed out stays
+// Ids are 0, 1, 2, ... in the order of add(). Thread-safe: one thread may add() while others
+// call load(), registrationCloud(), pose() or setPoses(). A registration copy handed out stays
 // valid after the cache evicts it (shared ownership).
 
 #include <Eigen/Core>
@@ -78,19 +76,12 @@ class KeyframeStore {
   ~KeyframeStore();
 
   /// Stores a keyframe (its time, odometry pose and full scan in the body frame) and returns its
-  /// id; its file is written in the background. t_s must be later than the previous keyframe's.
-  /// `registration_positions`, when given, are the scan's points filtered as registrationCloud()
-  /// filters them (the odometry's source cloud is): kept as its copy instead of filtering again.
-  /// InputError when an earlier keyframe's file could not be written.
-  std::uint64_t add(double t_s, const lie::SE3& T_odom_body,
-                    std::shared_ptr<const PointCloud> cloud_in_body,
+  /// id. t_s must be later than the previous keyframe's. InputError when the file cannot be
+  /// written. `registration_positions`, when given, are the scan's points filtered as
+  /// registrationCloud() filters them (the odometry's source cloud is): kept as its copy instead
+  /// of filtering the scan again (5 ms of a keyframe on the odometry's thread).
+  std::uint64_t add(double t_s, const lie::SE3& T_odom_body, const PointCloud& cloud_in_body,
                     const std::vector<Eigen::Vector3d>* registration_positions = nullptr);
-  /// add() with a copy of the scan.
-  std::uint64_t add(double t_s, const lie::SE3& T_odom_body, const PointCloud& cloud_in_body) {
-    return add(t_s, T_odom_body, std::make_shared<const PointCloud>(cloud_in_body));
-  }
-  /// Waits until every keyframe file is on disk; InputError when one could not be written.
-  void flush();
 
   std::size_t size() const;
   bool empty() const { return size() == 0; }
@@ -114,8 +105,7 @@ class KeyframeStore {
   Trajectory trajectory() const;
   /// Replaces every pose (one per keyframe, in id order) in RAM; writePoses() saves them.
   void setPoses(const std::vector<lie::SE3>& poses_T_map_body);
-  /// Rewrites DIR/poses.tum from the poses in RAM (write to a temporary file, then rename),
-  /// after the keyframe files it lists are on disk (InputError when one could not be written).
+  /// Rewrites DIR/poses.tum from the poses in RAM (write to a temporary file, then rename).
   void writePoses() const;
   /// Rewrites DIR/poses.tum with these poses of keyframes 0, 1, ... (their times and T_map_body;
   /// may be fewer than the store holds), the same way. A running `taiga run` publishes its

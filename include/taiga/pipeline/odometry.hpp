@@ -97,7 +97,7 @@ struct ScanOutcome {
   /// The keyframe this scan became (0, 1, ... in the order the odometry makes them; the
   /// keyframe store's ids), and its full deskewed scan in the body frame at t_s.
   std::optional<std::uint64_t> keyframe_id;
-  std::shared_ptr<const PointCloud> keyframe_cloud_in_body;
+  std::optional<PointCloud> keyframe_cloud_in_body;
   /// IMU-rate poses T_odom_body after the previous state up to t_s (propagated, as published in
   /// real time).
   std::vector<StampedPose> imu_rate_poses;
