@@ -39,12 +39,6 @@ void put(std::string& out, const T& value) {
 }
 
 template <class T>
-void putArray(std::string& out, const std::vector<T>& values) {
-  if (!values.empty())
-    out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-}
-
-template <class T>
 T get(std::string_view bytes, std::size_t offset) {
   T value;
   std::memcpy(&value, bytes.data() + offset, sizeof(T));
@@ -119,37 +113,55 @@ std::string readAll(const std::filesystem::path& path) {
 
 }  // namespace
 
-std::string encodeKeyframe(std::uint64_t id, double t_s, const PointCloud& cloud_in_body) {
+namespace {
+
+/// The file's bytes in order: the 40-byte header, then each channel's array whole (positions as
+/// x, y, z per point: Eigen's layout of a vector of Vector3d).
+struct Encoded {
+  std::string header;
+  std::vector<std::string_view> arrays;
+};
+
+template <class T>
+std::string_view bytesOf(const std::vector<T>& values) {
+  return {reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)};
+}
+
+Encoded encode(std::uint64_t id, double t_s, const PointCloud& cloud_in_body) {
+  static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "positions must be packed x, y, z");
   if (!cloud_in_body.isConsistent())
     throw InputError(fmt::format("keyframe {}: the cloud's channels differ in length", id));
-  const std::uint32_t channels = channelsOf(cloud_in_body);
-  const std::uint64_t n = cloud_in_body.size();
-  std::string out;
-  out.reserve(kHeaderBytes + n * bytesPerPoint(channels));
-  out.append(kMagic);
-  put(out, kVersion);
-  put(out, channels);
-  put(out, id);
-  put(out, t_s);
-  put(out, n);
-  for (const Eigen::Vector3d& p : cloud_in_body.positions) {
-    put(out, p.x());
-    put(out, p.y());
-    put(out, p.z());
-  }
-  putArray(out, cloud_in_body.times_s);
-  putArray(out, cloud_in_body.intensities);
-  putArray(out, cloud_in_body.rings);
-  putArray(out, cloud_in_body.columns);
+  Encoded out;
+  out.header.append(kMagic);
+  put(out.header, kVersion);
+  put(out.header, channelsOf(cloud_in_body));
+  put(out.header, id);
+  put(out.header, t_s);
+  put(out.header, std::uint64_t{cloud_in_body.size()});
+  out.arrays = {bytesOf(cloud_in_body.positions), bytesOf(cloud_in_body.times_s),
+                bytesOf(cloud_in_body.intensities), bytesOf(cloud_in_body.rings),
+                bytesOf(cloud_in_body.columns)};
+  return out;
+}
+
+}  // namespace
+
+std::string encodeKeyframe(std::uint64_t id, double t_s, const PointCloud& cloud_in_body) {
+  const Encoded encoded = encode(id, t_s, cloud_in_body);
+  std::string out = encoded.header;
+  for (const std::string_view array : encoded.arrays) out.append(array);
   return out;
 }
 
 void writeKeyframeFile(const std::filesystem::path& path, std::uint64_t id, double t_s,
                        const PointCloud& cloud_in_body) {
-  const std::string bytes = encodeKeyframe(id, t_s, cloud_in_body);
+  // Straight from the cloud's arrays: a copy of the file in RAM first cost a third of the write.
+  const Encoded encoded = encode(id, t_s, cloud_in_body);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw InputError(fmt::format("{}: cannot write the keyframe file", path.string()));
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.write(encoded.header.data(), static_cast<std::streamsize>(encoded.header.size()));
+  for (const std::string_view array : encoded.arrays)
+    out.write(array.data(), static_cast<std::streamsize>(array.size()));
   out.close();
   if (!out) throw writeFailed(path);
 }
