@@ -1,7 +1,8 @@
 // Reading a recording, as `taiga run`'s reader thread does it (issue 26: the reader took about
 // a fifth of the demo run's CPU): every event through io::Recording, timed as a whole, with
-// the scans' share. The first run computes a checksum (not timed) that covers every decoded channel of every scan (positions, times,
-// intensities, rings, columns) and the IMU readings: a faster reader must not change it.
+// the scans' share. The first run computes a checksum (not timed) that covers every decoded channel
+// of every scan (positions, times, intensities, rings, columns) and the IMU readings: a faster
+// reader must not change it.
 //
 //   read_bench RECORDING [CONFIG] [RUNS=3]     e.g. read_bench SIM/recording.bag SIM/rig.yaml
 #include <fmt/format.h>
@@ -68,8 +69,8 @@ int main(int argc, char** argv) {
   }
   fmt::print("{} scans ({:.0f} points each), {} IMU readings\n", scans,
              scans ? static_cast<double>(points) / static_cast<double>(scans) : 0.0, imu);
-  fmt::print("read in {:.1f} ms (median of {} runs), {:.2f} ms per scan\n",
-             median(total_ms), runs - 1, scans ? median(total_ms) / static_cast<double>(scans) : 0.0);
+  fmt::print("read in {:.1f} ms (median of {} runs), {:.2f} ms per scan\n", median(total_ms),
+             runs - 1, scans ? median(total_ms) / static_cast<double>(scans) : 0.0);
   fmt::print("checksum {:016x}\n", hash);
   return 0;
 }

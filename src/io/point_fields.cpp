@@ -17,7 +17,8 @@ namespace taiga::io {
 namespace {
 
 /// unpackValue, inlined into the decoding loop: a call per value was a third of it (read_bench).
-[[gnu::always_inline]] inline double unpackInline(const std::uint8_t* p, FieldType type, bool swap) {
+[[gnu::always_inline]] inline double unpackInline(const std::uint8_t* p, FieldType type,
+                                                  bool swap) {
   // Each type copies its own constant number of bytes: a copy of a size known only at run time
   // was a call into the C library per value, the largest part of decoding a scan.
   auto as = [p, swap]<class T>(T) {
@@ -47,7 +48,9 @@ namespace {
 
 }  // namespace
 
-double unpackValue(const std::uint8_t* p, FieldType type, bool swap) { return unpackInline(p, type, swap); }
+double unpackValue(const std::uint8_t* p, FieldType type, bool swap) {
+  return unpackInline(p, type, swap);
+}
 
 namespace {
 
@@ -256,7 +259,6 @@ struct DecodeFields {
 /// Positions whose three fields are T in the machine's byte order.
 template <class T>
 struct TypedXyz {
-  bool swap = false;  ///< the other fields' byte order: the machine's
   Eigen::Vector3d operator()(const std::uint8_t* record, const DecodeFields& f) const {
     auto at = [record](const PointField* field) {
       T value;
@@ -271,7 +273,8 @@ struct TypedXyz {
 struct AnyXyz {
   bool swap = false;
   Eigen::Vector3d operator()(const std::uint8_t* record, const DecodeFields& f) const {
-    return {unpackInline(record + f.x->offset, f.x->type, swap), unpackInline(record + f.y->offset, f.y->type, swap),
+    return {unpackInline(record + f.x->offset, f.x->type, swap),
+            unpackInline(record + f.y->offset, f.y->type, swap),
             unpackInline(record + f.z->offset, f.z->type, swap)};
   }
 };
@@ -280,9 +283,8 @@ struct AnyXyz {
 /// and ring; a record without a finite, non-zero position or a finite time is counted and left.
 /// Returns the absolute times' scale to seconds (0 without absolute times).
 template <class Xyz>
-double decodeRecords(const PackedPoints& points, double stamp_s, const PointDecodeOptions& options, const DecodeFields& f,
-                   Xyz xyz, DecodedPoints& out) {
-  const bool swap = xyz.swap;
+double decodeRecords(const PackedPoints& points, double stamp_s, const PointDecodeOptions& options,
+                     const DecodeFields& f, bool swap, Xyz xyz, DecodedPoints& out) {
   const TimeRule& time_rule = *f.time;
   const PointField* f_intensity = f.intensity;
   const PointField* f_ring = f.ring;
@@ -305,7 +307,8 @@ double decodeRecords(const PackedPoints& points, double stamp_s, const PointDeco
       if (options.deskewed) {
         // every point at the stamp
       } else if (time_rule.field) {
-        const double value = unpackInline(record + time_rule.field->offset, time_rule.field->type, swap);
+        const double value =
+            unpackInline(record + time_rule.field->offset, time_rule.field->type, swap);
         if (time_rule.absolute) {
           if (absolute_scale == 0.0) absolute_scale = absoluteScale(std::abs(value));
           t_s = value * absolute_scale;
@@ -325,9 +328,12 @@ double decodeRecords(const PackedPoints& points, double stamp_s, const PointDeco
       }
       cloud.positions.push_back(p);
       cloud.times_s.push_back(t_s);
-      if (f_intensity) cloud.intensities.push_back(static_cast<float>(unpackInline(record + f_intensity->offset, f_intensity->type, swap)));
+      if (f_intensity)
+        cloud.intensities.push_back(static_cast<float>(
+            unpackInline(record + f_intensity->offset, f_intensity->type, swap)));
       if (f_ring) {
-        cloud.rings.push_back(static_cast<std::uint16_t>(unpackInline(record + f_ring->offset, f_ring->type, swap)));
+        cloud.rings.push_back(
+            static_cast<std::uint16_t>(unpackInline(record + f_ring->offset, f_ring->type, swap)));
       } else if (organized) {
         cloud.rings.push_back(static_cast<std::uint16_t>(row));
       }
@@ -340,16 +346,20 @@ double decodeRecords(const PackedPoints& points, double stamp_s, const PointDeco
 
 }  // namespace
 
-DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, const PointDecodeOptions& options) {
+DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s,
+                                 const PointDecodeOptions& options) {
   checkLayout(points);
   const PointField* fx = findField(points.fields, "x");
   const PointField* fy = findField(points.fields, "y");
   const PointField* fz = findField(points.fields, "z");
   if (!fx || !fy || !fz) {
-    throw InputError(fmt::format("the points have no x, y and z fields (fields: {})", describeFields(points.fields)));
+    throw InputError(fmt::format("the points have no x, y and z fields (fields: {})",
+                                 describeFields(points.fields)));
   }
   for (const PointField* f : {fx, fy, fz}) {
-    if (isInteger(f->type)) throw InputError(fmt::format("field '{}' is {}, expected float32 or float64", f->name, fieldTypeName(f->type)));
+    if (isInteger(f->type))
+      throw InputError(fmt::format("field '{}' is {}, expected float32 or float64", f->name,
+                                   fieldTypeName(f->type)));
   }
   const PointField* f_intensity = findField(points.fields, "reflectivity");
   if (!f_intensity) f_intensity = findField(points.fields, "intensity");
@@ -361,15 +371,17 @@ DecodedPoints decodePackedPoints(const PackedPoints& points, double stamp_s, con
   DecodedPoints out;
   double absolute_scale = 0.0;
   const DecodeFields fields{fx, fy, fz, f_intensity, f_ring, &time_rule};
-  const auto all = [&](FieldType type) { return fx->type == type && fy->type == type && fz->type == type; };
+  const auto all = [&](FieldType type) {
+    return fx->type == type && fy->type == type && fz->type == type;
+  };
   // The positions are most of the bytes: read with their type known at compile time when the
   // three share it (a reading switched per value was half of decoding a scan, bench/read_bench).
   if (all(FieldType::kFloat32) && !swap) {
-    absolute_scale = decodeRecords(points, stamp_s, options, fields, TypedXyz<float>{}, out);
+    absolute_scale = decodeRecords(points, stamp_s, options, fields, swap, TypedXyz<float>{}, out);
   } else if (all(FieldType::kFloat64) && !swap) {
-    absolute_scale = decodeRecords(points, stamp_s, options, fields, TypedXyz<double>{}, out);
+    absolute_scale = decodeRecords(points, stamp_s, options, fields, swap, TypedXyz<double>{}, out);
   } else {
-    absolute_scale = decodeRecords(points, stamp_s, options, fields, AnyXyz{swap}, out);
+    absolute_scale = decodeRecords(points, stamp_s, options, fields, swap, AnyXyz{swap}, out);
   }
   if (options.deskewed) {
     out.time_source = PointTimeSource::kStamp;

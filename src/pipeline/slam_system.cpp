@@ -107,9 +107,9 @@ void SlamSystem::handleOutcome(const ScanOutcome& outcome, bool live) {
   // 9. The keyframe's scan to disk; 10. into the mapping graph.
   // The odometry's source cloud is the scan filtered as the store's registration copies are
   // (both at odometry.voxel_size_m with its voxel_point): the store keeps it, not a refiltering.
-  const std::uint64_t id = store_.add(
-      outcome.t_s, outcome.T_odom_body, *outcome.keyframe_cloud_in_body,
-      outcome.source_cloud_in_body ? &outcome.source_cloud_in_body->positions : nullptr);
+  const std::uint64_t id =
+      store_.add(outcome.t_s, outcome.T_odom_body, *outcome.keyframe_cloud_in_body,
+                 outcome.source_cloud_in_body ? &outcome.source_cloud_in_body->positions : nullptr);
   if (id != *outcome.keyframe_id)
     throw std::logic_error("SlamSystem: the store's keyframe ids differ from the odometry's");
   mapping_thread_.addKeyframe(id, outcome.t_s, outcome.T_odom_body, outcome.map_segment);

@@ -94,6 +94,39 @@ TEST(PointFields, VelodyneRelativeSecondsAndBigEndian) {
   }
 }
 
+// The positions are read by type-specific code for float32 and float64 in the machine's order,
+// and by the general reader otherwise: every layout gives the same cloud.
+TEST(PointFields, EveryPositionLayoutGivesTheSameCloud) {
+  auto decoded = [](F x_type, F yz_type, bool big_endian) {
+    const std::uint32_t x_size = fieldTypeSize(x_type), yz_size = fieldTypeSize(yz_type);
+    Packer packer({{"x", 0, x_type},
+                   {"y", x_size, yz_type},
+                   {"z", x_size + yz_size, yz_type},
+                   {"t", x_size + 2 * yz_size, F::kUint32},
+                   {"ring", x_size + 2 * yz_size + 4, F::kUint16}},
+                  big_endian);
+    packer.add({1.5, -2.25, 0.5, 1e6, 3});
+    packer.add({0.0, 0.0, 0.0, 2e6, 4});  // no return
+    packer.add({-7.75, 12.125, -1.0, 3e6, 5});
+    return decodePackedPoints(packer.finish(), 100.0);
+  };
+  const DecodedPoints reference = decoded(F::kFloat32, F::kFloat32, false);
+  ASSERT_EQ(reference.cloud.size(), 2u);
+  EXPECT_EQ(reference.cloud.positions[1], Eigen::Vector3d(-7.75, 12.125, -1.0));
+  for (const auto& [x_type, yz_type] : {std::pair{F::kFloat64, F::kFloat64},
+                                        std::pair{F::kFloat64, F::kFloat32},
+                                        std::pair{F::kFloat32, F::kFloat64}}) {
+    for (const bool big_endian : {false, true}) {
+      const DecodedPoints d = decoded(x_type, yz_type, big_endian);
+      EXPECT_EQ(d.cloud.positions, reference.cloud.positions) << big_endian;
+      EXPECT_EQ(d.cloud.times_s, reference.cloud.times_s) << big_endian;
+      EXPECT_EQ(d.cloud.rings, reference.cloud.rings) << big_endian;
+      EXPECT_EQ(d.dropped_invalid, 1u);
+    }
+  }
+  EXPECT_EQ(decoded(F::kFloat32, F::kFloat32, true).cloud.positions, reference.cloud.positions);
+}
+
 TEST(PointFields, AbsoluteTimestampsInSecondsOrNanoseconds) {
   // Hesai: float64 seconds; Livox 2: float64 nanoseconds. Both absolute, whatever the stamp.
   for (double scale : {1.0, 1e9}) {
