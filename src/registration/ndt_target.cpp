@@ -103,7 +103,13 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
   keys_.reserve(moments.size());
   std::vector<NotStem> not_stems;
   for (const CellMoments& m : moments) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(m.covariance);
+    // Closed form (Eigen's computeDirect) rather than the iterative QR: most of the target's
+    // build (local_map_bench: 11-12 -> 5 ms a keyframe). On the demo's 722 000 cells the
+    // regularized inverse covariances of the two agree to 1e-11 relative at worst (two close
+    // small eigenvalues), since the clamp below discards what the closed form loses of the
+    // smallest eigenvalues (bench/BENCHMARK.md, "Session 68").
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(m.covariance);
     Eigen::Vector3d lambda = solver.eigenvalues();
     const double lambda_max = lambda.maxCoeff();
     if (!(lambda_max > 0.0)) continue;  // all points equal (after quantization)
