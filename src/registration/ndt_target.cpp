@@ -104,7 +104,7 @@ NdtTarget::NdtTarget(const VoxelStatistics& stats, const NdtConfig& cells)
   std::vector<NotStem> not_stems;
   for (const CellMoments& m : moments) {
     // Closed form (Eigen's computeDirect) rather than the iterative QR: most of the target's
-    // build (local_map_bench: 11-12 -> 5 ms a keyframe). On the demo's 722 000 cells the
+    // build (local_map_bench: 10.4 -> 7.4-7.8 ms a keyframe). On the demo's 722 000 cells the
     // regularized inverse covariances of the two agree to 1e-11 relative at worst (two close
     // small eigenvalues), since the clamp below discards what the closed form loses of the
     // smallest eigenvalues (bench/BENCHMARK.md, "Session 68").
