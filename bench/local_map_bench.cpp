@@ -33,6 +33,7 @@
 #include "taiga/preprocess/voxel_filter.hpp"
 #include "taiga/registration/kdtree.hpp"
 #include "taiga/registration/ndt.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/voxel_nearest.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
@@ -123,7 +124,7 @@ int main(int argc, char** argv) {
   std::uint64_t hash = 0;
   std::size_t cells = 0, points = 0;
   for (int run = 0; run < runs; ++run) {
-    registration::VoxelStatistics point_statistics(o.local_map_voxel_m);
+    registration::VoxelMeans point_statistics(o.local_map_voxel_m);
     registration::VoxelStatistics ndt_statistics(o.ndt_resolution_m, rules.stem_cells);
     std::deque<const Keyframe*> window;
     std::vector<std::vector<double>> ms(kStages + kExtras);
@@ -138,8 +139,8 @@ int main(int argc, char** argv) {
       }
       double stage_ms[kStages] = {};
       auto start = Clock::now();
-      point_statistics.add(keyframe.points_in_odom, keyframe.beams);
-      if (dropped) point_statistics.remove(dropped->points_in_odom, dropped->beams);
+      point_statistics.add(keyframe.points_in_odom);
+      if (dropped) point_statistics.remove(dropped->points_in_odom);
       stage_ms[0] = msSince(start);
       start = Clock::now();
       ndt_statistics.add(keyframe.points_in_odom, keyframe.beams);

@@ -25,6 +25,7 @@
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/registration/gicp.hpp"
 #include "taiga/registration/ndt.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
 namespace {

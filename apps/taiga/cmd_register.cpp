@@ -13,7 +13,7 @@
 #include "taiga/core/errors.hpp"
 #include "taiga/io/cloud_files.hpp"
 #include "taiga/registration/registration.hpp"
-#include "taiga/registration/voxel_statistics.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/yaw_search.hpp"
 
 namespace taiga::app {

@@ -14,7 +14,7 @@ LocalMap::LocalMap(std::vector<double> ndt_resolutions_m, double point_spacing_m
       gicp_config_(gicp),
       ndt_cells_(ndt),
       p_keyframe_lidar_(p_keyframe_lidar),
-      point_statistics_(point_spacing_m) {
+      point_means_(point_spacing_m) {
   setNdtResolutions(ndt_resolutions_m);
 }
 
@@ -81,34 +81,37 @@ void LocalMap::startBuild(const std::vector<const Keyframe*>& added,
   };
   for (const Keyframe* keyframe : added) put(*keyframe, +1);
   for (const Keyframe* keyframe : removed) put(*keyframe, -1);
-  // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
-  auto account = [in_odom](registration::VoxelStatistics& statistics) {
-    for (const InOdom& keyframe : *in_odom) {
-      if (keyframe.sign > 0) {
-        statistics.add(keyframe.points, keyframe.beams);
-      } else {
-        statistics.remove(keyframe.points, keyframe.beams);
-      }
-    }
-  };
-  pending_ndt_ = std::async(std::launch::async, [this, account] {
+  pending_ndt_ = std::async(std::launch::async, [this, in_odom] {
     NdtStructures built;
     built.targets.resize(ndt_statistics_.size());
     tbb::parallel_for(std::size_t{0}, ndt_statistics_.size(), [&](std::size_t i) {
       registration::VoxelStatistics& statistics = ndt_statistics_[i];
-      account(statistics);
+      // Only statistics with circle moments (the stem cells') keep the beams' noise shares.
+      for (const InOdom& keyframe : *in_odom) {
+        if (keyframe.sign > 0) {
+          statistics.add(keyframe.points, keyframe.beams);
+        } else {
+          statistics.remove(keyframe.points, keyframe.beams);
+        }
+      }
       built.targets[i] = std::make_unique<registration::NdtTarget>(
           statistics, ndt_cells_.cellsAt(statistics.resolution_m()));
     });
     return built;
   });
-  pending_points_ = std::async(std::launch::async, [this, account] {
-    account(point_statistics_);
+  pending_points_ = std::async(std::launch::async, [this, in_odom] {
+    for (const InOdom& keyframe : *in_odom) {
+      if (keyframe.sign > 0) {
+        point_means_.add(keyframe.points);
+      } else {
+        point_means_.remove(keyframe.points);
+      }
+    }
     PointStructures built;
     // The index buckets the means by its cells: they need no sort, and come out of it in an
     // order local enough for the GICP cloud's kd-tree.
     built.nearest = std::make_unique<registration::VoxelNearest>(
-        point_statistics_.meansInTableOrder(), kNearestCell_m);
+        point_means_.meansInTableOrder(), kNearestCell_m);
     if (target_ == Target::kGicp) {
       built.gicp_cloud =
           std::make_unique<registration::GicpCloud>(built.nearest->points(), gicp_config_);
@@ -139,7 +142,7 @@ void LocalMap::repose(
         T_odom_keyframe_at) {
   finishPendingBuild();
   for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
-  point_statistics_.clear();
+  point_means_.clear();
   std::vector<const Keyframe*> all;
   for (Keyframe& keyframe : keyframes_) {
     keyframe.T_odom_keyframe = T_odom_keyframe_at(keyframe.id, keyframe.T_odom_keyframe);
@@ -165,7 +168,7 @@ void LocalMap::beginRegistration() {
 void LocalMap::clear() {
   finishPendingBuild();
   for (registration::VoxelStatistics& statistics : ndt_statistics_) statistics.clear();
-  point_statistics_.clear();
+  point_means_.clear();
   keyframes_.clear();
   ndt_in_use_ = {};
   points_in_use_ = {};

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "taiga/core/radix_sort.hpp"
+#include "voxel_quanta.hpp"
 
 namespace taiga::registration {
 
@@ -70,16 +71,11 @@ void VoxelStatistics::addNoiseShare(const Eigen::Vector3d& p, const std::int64_t
 }
 
 void VoxelStatistics::update(const Eigen::Vector3d& p, int sign, const BeamNoise* beams) {
-  const VoxelKey key = voxelOf(p, inverse_resolution_);
-  if (key == kInvalidVoxel) {
+  VoxelKey key;
+  std::int64_t q[3];
+  if (!detail::quantize(p, resolution_m_, inverse_resolution_, key, q)) {
     if (sign > 0) ++skipped_;
     return;
-  }
-  const Eigen::Matrix<std::int64_t, 3, 1> index = unpackVoxel(key);
-  std::int64_t q[3];
-  for (int a = 0; a < 3; ++a) {
-    const double centre = (static_cast<double>(index[a]) + 0.5) * resolution_m_;
-    q[a] = std::llround((p[a] - centre) / kQuantum_m);
   }
   // One hash lookup per point (a find and then an insert were two: a third of this function).
   const auto it = sign > 0 ? cells_.try_emplace(key).first : cells_.find(key);
@@ -131,11 +127,7 @@ std::size_t VoxelStatistics::numPoints() const {
 }
 
 Eigen::Vector3d VoxelStatistics::meanOf(VoxelKey key, const Sums& sums) const {
-  const Eigen::Matrix<std::int64_t, 3, 1> index = unpackVoxel(key);
-  const Eigen::Vector3d centre = (index.cast<double>().array() + 0.5) * resolution_m_;
-  const Eigen::Vector3d s(static_cast<double>(sums.s[0]), static_cast<double>(sums.s[1]),
-                          static_cast<double>(sums.s[2]));
-  return centre + s * (kQuantum_m / static_cast<double>(sums.count));
+  return detail::meanOf(key, resolution_m_, sums.count, sums.s);
 }
 
 CellMoments VoxelStatistics::momentsOf(VoxelKey key, const Sums& sums) const {
@@ -214,34 +206,11 @@ std::vector<CellMoments> VoxelStatistics::moments(std::size_t min_points) const 
   return out;
 }
 
-std::vector<Eigen::Vector3d> VoxelStatistics::means() const {
-  std::vector<std::pair<VoxelKey, Eigen::Vector3d>> cells;
-  cells.reserve(cells_.size());
-  for (const auto& [key, sums] : cells_) cells.emplace_back(key, meanOf(key, sums));
-  radixSortByVoxelKey(cells);
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(cells.size());
-  for (const auto& cell : cells) out.push_back(cell.second);
-  return out;
-}
-
-std::vector<Eigen::Vector3d> VoxelStatistics::meansInTableOrder() const {
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(cells_.size());
-  for (const auto& [key, sums] : cells_) out.push_back(meanOf(key, sums));
-  return out;
-}
-
 bool VoxelStatistics::operator==(const VoxelStatistics& other) const {
   return resolution_m_ == other.resolution_m_ && cells_ == other.cells_ &&
          circle_cells_ == other.circle_cells_;
 }
 
-std::vector<Eigen::Vector3d> voxelDownsample(std::span<const Eigen::Vector3d> points,
-                                             double leaf_m) {
-  VoxelStatistics stats(leaf_m);
-  stats.add(points);
-  return stats.means();
-}
+
 
 }  // namespace taiga::registration

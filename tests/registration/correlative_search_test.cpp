@@ -9,6 +9,7 @@
 
 #include "registration_data.hpp"
 #include "taiga/registration/registration.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
 namespace taiga::registration {

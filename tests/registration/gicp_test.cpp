@@ -12,6 +12,7 @@
 #include "taiga/core/angles.hpp"
 #include "taiga/registration/kdtree.hpp"
 #include "taiga/registration/registration.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
 namespace taiga::registration {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "registration_data.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
 namespace taiga::registration {

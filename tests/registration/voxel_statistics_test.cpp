@@ -125,14 +125,5 @@ TEST(VoxelStatistics, RemovingAPointThatWasNeverAddedThrows) {
   EXPECT_THROW(VoxelStatistics(0.0), std::invalid_argument);
 }
 
-TEST(VoxelStatistics, DownsampleKeepsOnePointPerCell) {
-  const std::vector<Eigen::Vector3d> p = {
-      {0.1, 0.1, 0.1}, {0.3, 0.3, 0.3}, {1.5, 0.1, 0.1}, {std::nan(""), 0.0, 0.0}};
-  const auto down = voxelDownsample(p, 1.0);
-  ASSERT_EQ(down.size(), 2u);
-  EXPECT_NEAR(down[0].x(), 0.2, 1e-5);
-  EXPECT_NEAR(down[1].x(), 1.5, 1e-5);
-}
-
 }  // namespace
 }  // namespace taiga::registration

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "registration_data.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
 namespace taiga::registration {

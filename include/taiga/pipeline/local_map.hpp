@@ -25,6 +25,7 @@
 #include "taiga/registration/correlative_search.hpp"
 #include "taiga/registration/gicp.hpp"
 #include "taiga/registration/ndt.hpp"
+#include "taiga/registration/voxel_means.hpp"
 #include "taiga/registration/voxel_nearest.hpp"
 #include "taiga/registration/voxel_statistics.hpp"
 
@@ -127,7 +128,7 @@ class LocalMap {
 
   std::deque<Keyframe> keyframes_;
   std::vector<registration::VoxelStatistics> ndt_statistics_;  ///< NDT cells, coarse to fine
-  registration::VoxelStatistics point_statistics_;  ///< one mean per point_spacing_m voxel
+  registration::VoxelMeans point_means_;  ///< one mean per point_spacing_m voxel
   std::vector<Keyframe> dropped_;  ///< removed from the statistics by the pending build
   NdtStructures ndt_in_use_;
   mutable PointStructures points_in_use_;

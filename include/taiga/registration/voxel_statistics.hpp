@@ -1,7 +1,8 @@
 #pragma once
 // Incremental voxel statistics: per cell the count, the sum of points and the sum of their outer
 // products, so that a keyframe's points can be added to and removed from a local map without
-// rebuilding it. The NDT target (ndt.hpp) and voxel downsampling are built from these sums.
+// rebuilding it. The NDT target (ndt.hpp) is built from these sums; VoxelMeans (voxel_means.hpp)
+// keeps the counts and sums alone, for means.
 //
 // Sums are kept as integers: each point is quantized to kQuantum_m (10 um) relative to the centre
 // of its cell. Adding and then removing the same points therefore restores the statistics exactly,
@@ -93,13 +94,6 @@ class VoxelStatistics {
   /// Moments of every cell with at least `min_points` points, sorted by voxel key (so the order
   /// is deterministic).
   std::vector<CellMoments> moments(std::size_t min_points = 1) const;
-  /// Cell means of every occupied cell, in key order: a voxel-grid downsampling.
-  std::vector<Eigen::Vector3d> means() const;
-  /// The same means in the hash table's order, which depends only on the sequence of adds and
-  /// removes (the same in every run of it): for a structure that orders them itself, without
-  /// the sort (on a local map the sort took half of means(), bench/local_map_bench).
-  std::vector<Eigen::Vector3d> meansInTableOrder() const;
-
   /// Exact equality of the sums (the same cells with the same integer sums).
   bool operator==(const VoxelStatistics& other) const;
 
@@ -135,9 +129,5 @@ class VoxelStatistics {
   bool circle_moments_ = false;
   tsl::robin_map<VoxelKey, CircleSums, MixedKeyHash> circle_cells_;  ///< with circle_moments
 };
-
-/// Voxel-grid downsampling: one point (the mean) per occupied cell of `leaf_m`, in key order.
-std::vector<Eigen::Vector3d> voxelDownsample(std::span<const Eigen::Vector3d> points,
-                                             double leaf_m);
 
 }  // namespace taiga::registration
