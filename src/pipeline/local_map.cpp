@@ -110,8 +110,8 @@ void LocalMap::startBuild(const std::vector<const Keyframe*>& added,
     PointStructures built;
     // The index buckets the means by its cells: they need no sort, and come out of it in an
     // order local enough for the GICP cloud's kd-tree.
-    built.nearest = std::make_unique<registration::VoxelNearest>(
-        point_means_.meansInTableOrder(), kNearestCell_m);
+    built.nearest = std::make_unique<registration::VoxelNearest>(point_means_.meansInTableOrder(),
+                                                                 kNearestCell_m);
     if (target_ == Target::kGicp) {
       built.gicp_cloud =
           std::make_unique<registration::GicpCloud>(built.nearest->points(), gicp_config_);

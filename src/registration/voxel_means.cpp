@@ -25,7 +25,8 @@ void VoxelMeans::update(const Eigen::Vector3d& p, int sign) {
     return;
   }
   const auto it = sign > 0 ? cells_.try_emplace(key).first : cells_.find(key);
-  if (it == cells_.end()) throw std::logic_error("VoxelMeans::remove: a point that was never added");
+  if (it == cells_.end())
+    throw std::logic_error("VoxelMeans::remove: a point that was never added");
   Sums& sums = it.value();
   sums.count += sign;
   for (int a = 0; a < 3; ++a) sums.s[a] += sign * q[a];

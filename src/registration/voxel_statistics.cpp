@@ -126,10 +126,6 @@ std::size_t VoxelStatistics::numPoints() const {
   return n;
 }
 
-Eigen::Vector3d VoxelStatistics::meanOf(VoxelKey key, const Sums& sums) const {
-  return detail::meanOf(key, resolution_m_, sums.count, sums.s);
-}
-
 CellMoments VoxelStatistics::momentsOf(VoxelKey key, const Sums& sums) const {
   CellMoments m;
   m.key = key;
@@ -137,7 +133,7 @@ CellMoments VoxelStatistics::momentsOf(VoxelKey key, const Sums& sums) const {
   const double n = static_cast<double>(sums.count);
   const Eigen::Vector3d s(static_cast<double>(sums.s[0]), static_cast<double>(sums.s[1]),
                           static_cast<double>(sums.s[2]));
-  m.mean = meanOf(key, sums);
+  m.mean = detail::meanOf(key, resolution_m_, sums.count, sums.s);
   if (sums.count >= 2) {
     Eigen::Matrix3d ss;
     ss << static_cast<double>(sums.ss[0]), static_cast<double>(sums.ss[1]),
@@ -210,7 +206,5 @@ bool VoxelStatistics::operator==(const VoxelStatistics& other) const {
   return resolution_m_ == other.resolution_m_ && cells_ == other.cells_ &&
          circle_cells_ == other.circle_cells_;
 }
-
-
 
 }  // namespace taiga::registration

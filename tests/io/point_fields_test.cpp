@@ -113,9 +113,9 @@ TEST(PointFields, EveryPositionLayoutGivesTheSameCloud) {
   const DecodedPoints reference = decoded(F::kFloat32, F::kFloat32, false);
   ASSERT_EQ(reference.cloud.size(), 2u);
   EXPECT_EQ(reference.cloud.positions[1], Eigen::Vector3d(-7.75, 12.125, -1.0));
-  for (const auto& [x_type, yz_type] : {std::pair{F::kFloat64, F::kFloat64},
-                                        std::pair{F::kFloat64, F::kFloat32},
-                                        std::pair{F::kFloat32, F::kFloat64}}) {
+  for (const auto& [x_type, yz_type] :
+       {std::pair{F::kFloat64, F::kFloat64}, std::pair{F::kFloat64, F::kFloat32},
+        std::pair{F::kFloat32, F::kFloat64}}) {
     for (const bool big_endian : {false, true}) {
       const DecodedPoints d = decoded(x_type, yz_type, big_endian);
       EXPECT_EQ(d.cloud.positions, reference.cloud.positions) << big_endian;

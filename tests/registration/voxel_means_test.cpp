@@ -44,7 +44,8 @@ TEST(VoxelMeans, TheMeansOfVoxelStatisticsBitForBitAndRemovedExactly) {
   // Removing b leaves a's means, in the same table order as never having added b when the
   // sequences agree: only_a's.
   means.remove(b);
-  std::vector<Eigen::Vector3d> left = means.meansInTableOrder(), expected = only_a.meansInTableOrder();
+  std::vector<Eigen::Vector3d> left = means.meansInTableOrder(),
+                               expected = only_a.meansInTableOrder();
   ASSERT_EQ(left.size(), expected.size());
   auto by_x = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
     return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
@@ -59,7 +60,8 @@ TEST(VoxelMeans, TheMeansOfVoxelStatisticsBitForBitAndRemovedExactly) {
 
 TEST(VoxelMeans, SkipsPointsWithoutACellAndRejectsABadResolution) {
   VoxelMeans means(0.5);
-  means.add(std::vector<Eigen::Vector3d>{{std::nan(""), 0.0, 0.0}, {0.1, 0.1, 0.1}, {1e9, 0.0, 0.0}});
+  means.add(
+      std::vector<Eigen::Vector3d>{{std::nan(""), 0.0, 0.0}, {0.1, 0.1, 0.1}, {1e9, 0.0, 0.0}});
   EXPECT_EQ(means.numSkipped(), 2u);
   EXPECT_EQ(means.numPoints(), 1u);
   EXPECT_THROW(VoxelMeans(0.0), std::invalid_argument);

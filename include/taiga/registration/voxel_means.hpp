@@ -7,10 +7,11 @@
 // table's cache misses were most of the update (bench/local_map_bench, bench/BENCHMARK.md
 // "Session 68").
 
+#include <tsl/robin_map.h>
+
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
-#include <tsl/robin_map.h>
 #include <vector>
 
 #include "taiga/core/hash.hpp"

@@ -116,7 +116,6 @@ class VoxelStatistics {
   /// quanta) to a cell's circle sums; nothing for a zero noise.
   static void addNoiseShare(const Eigen::Vector3d& p, const std::int64_t q[3],
                             const BeamNoise& beams, int sign, CircleSums& circle);
-  Eigen::Vector3d meanOf(VoxelKey key, const Sums& sums) const;
   CellMoments momentsOf(VoxelKey key, const Sums& sums) const;
   static void circleMoments(const Sums& sums, const CircleSums& circle, CellMoments& m);
 
