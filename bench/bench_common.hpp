@@ -31,4 +31,10 @@ inline std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t has
   return hash;
 }
 
+/// FNV-1a over the bytes of a vector's elements, continued from `hash`.
+template <class T>
+std::uint64_t fnv1a(const std::vector<T>& values, std::uint64_t hash) {
+  return fnv1a(values.data(), values.size() * sizeof(T), hash);
+}
+
 }  // namespace taiga::bench

@@ -29,15 +29,6 @@ using bench::Clock;
 using bench::median;
 using bench::msSince;
 
-namespace {
-
-/// FNV-1a over the bytes of the points, continued from `hash`.
-std::uint64_t checksum(const std::vector<Eigen::Vector3d>& points, std::uint64_t hash) {
-  return bench::fnv1a(points.data(), points.size() * sizeof(Eigen::Vector3d), hash);
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
   if (argc < 2) {
     fmt::print(stderr, "usage: preprocess_bench SIM [RUNS=3] [SCANS=100]\n");
@@ -89,8 +80,8 @@ int main(int argc, char** argv) {
       kept += n;
       voxels += source.size();
       if (run == 0)
-        hash = checksum(keyframe.positions,
-                        checksum(source.positions, checksum(in_body.positions, hash)));
+        hash = bench::fnv1a(keyframe.positions,
+                            bench::fnv1a(source.positions, bench::fnv1a(in_body.positions, hash)));
     }
     for (int s = 0; s < 5; ++s) per_run[s].push_back(median(ms[s]));
   }

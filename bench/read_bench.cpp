@@ -22,15 +22,6 @@ using bench::Clock;
 using bench::median;
 using bench::msSince;
 
-namespace {
-
-template <class T>
-std::uint64_t checksum(const std::vector<T>& values, std::uint64_t hash) {
-  return bench::fnv1a(values.data(), values.size() * sizeof(T), hash);
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
   if (argc < 2) {
     fmt::print(stderr, "usage: read_bench RECORDING [CONFIG] [RUNS=3]\n");
@@ -52,11 +43,11 @@ int main(int argc, char** argv) {
         ++scans;
         points += c.size();
         if (run > 0) continue;
-        hash = checksum(c.positions, hash);
-        hash = checksum(c.times_s, hash);
-        hash = checksum(c.intensities, hash);
-        hash = checksum(c.rings, hash);
-        hash = checksum(c.columns, hash);
+        hash = bench::fnv1a(c.positions, hash);
+        hash = bench::fnv1a(c.times_s, hash);
+        hash = bench::fnv1a(c.intensities, hash);
+        hash = bench::fnv1a(c.rings, hash);
+        hash = bench::fnv1a(c.columns, hash);
       } else if (const auto* sample = std::get_if<ImuSample>(&*event)) {
         ++imu;
         if (run > 0) continue;
